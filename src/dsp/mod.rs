@@ -1,0 +1,1 @@
+//! Real-time signal processing: no plugin framework, no allocation after `prepare`.

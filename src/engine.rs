@@ -1,0 +1,1 @@
+//! Voices and routing: the single entry used by the plugin, the renderer, tests and benches.

@@ -1,0 +1,117 @@
+//! The modal bank, format version 1: plain data in natural units.
+//!
+//! `presets/README.md` documents the format for people; `presets/modal-bank.schema.json` is
+//! generated from these types for editors.
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// Value of the `format` field that marks a document as a modal bank.
+pub const FORMAT_NAME: &str = "modal-bank";
+
+/// The major format version this build reads and writes.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// A modal bank: how one object rings when struck at each of its measured positions.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Bank {
+    /// Always `"modal-bank"`.
+    pub format: String,
+    /// Major format version; this build reads version 1.
+    pub version: u32,
+    /// Display name, for example "Steel bar, 30 cm".
+    pub name: String,
+    /// What the object is and how it sounds.
+    #[serde(default)]
+    pub description: String,
+    /// Who made the bank.
+    #[serde(default)]
+    pub author: String,
+    /// SPDX licence identifier of the bank data, for example "CC0-1.0".
+    #[serde(default)]
+    pub license: String,
+    /// Free-form details of how the bank was made; `kind` names the method
+    /// ("analytic", "fitted", "edited", ...).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source: Option<serde_json::Map<String, serde_json::Value>>,
+    /// Pitch in Hz the bank sounds at size 1: the MIDI key with this equal-tempered pitch plays the
+    /// bank as authored. When absent, the lowest of the strongest modes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub root_hz: Option<f64>,
+    /// The strike positions whose gains each mode lists, in order.
+    pub positions: Vec<Position>,
+    /// The modes, in any order.
+    pub modes: Vec<Mode>,
+    /// Parameter defaults that suit this bank.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub defaults: Option<BankDefaults>,
+}
+
+/// A strike position: where on the object the gains of column k were measured or computed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Position {
+    /// Display name, for example "edge" or "centre".
+    pub name: String,
+    /// Coordinates on the object: one value (along a line) or two (on a surface), in any unit
+    /// consistent within the bank (usually fractions of the object's length).
+    pub coords: Vec<f64>,
+}
+
+/// One mode of vibration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Mode {
+    /// Frequency in Hz at size 1.
+    pub freq_hz: f64,
+    /// Exponential decay rate of the amplitude in 1/s (T60 = 3 ln 10 / decay).
+    pub decay_per_s: f64,
+    /// Signed linear amplitude of the mode for a unit impulse at each position, one per position.
+    pub gains: Vec<f64>,
+}
+
+/// Parameter defaults a bank can carry. Every field is optional.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct BankDefaults {
+    /// Material quality factor Q (decays scale by the bank's own Q over this one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material_q: Option<f64>,
+    /// Damping tilt: decays scale by `(f / f_lowest) ^ tilt`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damping_tilt: Option<f64>,
+    /// Mallet contact time in milliseconds (short = hard and bright).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hardness_ms: Option<f64>,
+    /// Strike position along the bank's positions, 0 to 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub strike_position: Option<f64>,
+    /// Key tracking in percent (0 = every key plays the bank's own pitch).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub key_tracking_pct: Option<f64>,
+}
+
+impl Bank {
+    /// A bank with no modes and the given positions, ready to be filled.
+    pub fn new(name: impl Into<String>, positions: Vec<Position>) -> Self {
+        Self {
+            format: FORMAT_NAME.to_string(),
+            version: FORMAT_VERSION,
+            name: name.into(),
+            description: String::new(),
+            author: String::new(),
+            license: String::new(),
+            source: None,
+            root_hz: None,
+            positions,
+            modes: Vec::new(),
+            defaults: None,
+        }
+    }
+
+    /// Number of strike positions (columns of the gain matrix).
+    pub fn num_positions(&self) -> usize {
+        self.positions.len()
+    }
+}

@@ -1,0 +1,1 @@
+//! Offline rendering over the engine.
