@@ -1,1 +1,148 @@
-fn main() {}
+//! Resonator throughput and engine real-time factor.
+//!
+//! Run with `cargo bench`. Every case renders a fixed amount of audio and prints a figure:
+//! mode-samples per second for each kernel at several bank sizes (all kernels in the same run, so
+//! ratios are side by side), then the real-time factor of 16 voices x 256 modes at 48 kHz in
+//! 64-sample blocks through the whole engine.
+
+use std::hint::black_box;
+use std::sync::Arc;
+use std::time::Instant;
+
+use modal_resonator::dsp::coeffs::ModeCoeffs;
+use modal_resonator::dsp::{Kernel, ResonatorBank, COLUMNS};
+use modal_resonator::engine::{Engine, NoteEvent, PreparedBank};
+use modal_resonator::model::{Bank, Mode, Position};
+
+const RATE_HZ: f64 = 48_000.0;
+const BLOCK: usize = 64;
+/// Mode-samples rendered per case by the vector kernels (the scalar oracle renders 1/8 of it).
+const WORK: usize = 1 << 30;
+/// Each case is timed this many times; the fastest counts (the machine is shared).
+const REPEATS: usize = 3;
+
+fn bank_of(num_modes: usize) -> ResonatorBank {
+    let mut bank = ResonatorBank::new(num_modes);
+    for m in 0..num_modes {
+        let f = 50.0 + (m as f64 * 7.31) % 20_000.0;
+        // T60 of about a minute: every mode stays live for the whole case.
+        bank.activate(m, ModeCoeffs::from_freq_decay(RATE_HZ, f, 0.1), 0.0);
+    }
+    // Ring the modes up so the state is non-trivial.
+    let mut acc = vec![[0.0f32; COLUMNS]; BLOCK];
+    let mut x = vec![0.0f32; BLOCK];
+    x[0] = 1.0;
+    bank.set_gains_with(|m| 1.0 / (1.0 + m as f32));
+    bank.process(Kernel::Scalar, Some(&x), &mut acc);
+    bank
+}
+
+fn mode_samples_per_s(kernel: Kernel, num_modes: usize, work: usize) -> f64 {
+    let blocks = (work / (num_modes * BLOCK)).max(1);
+    let mut best = f64::INFINITY;
+    for _ in 0..REPEATS {
+        let mut bank = bank_of(num_modes);
+        let mut acc = vec![[0.0f32; COLUMNS]; BLOCK];
+        let start = Instant::now();
+        for _ in 0..blocks {
+            acc.fill([0.0; COLUMNS]);
+            bank.process(kernel, None, &mut acc);
+            black_box(&mut acc);
+        }
+        best = best.min(start.elapsed().as_secs_f64());
+    }
+    (blocks * BLOCK * num_modes) as f64 / best
+}
+
+fn engine_realtime_factor(kernel: Kernel) -> (f64, usize) {
+    let positions = vec![Position {
+        name: "a".into(),
+        coords: vec![0.0],
+    }];
+    let mut bank = Bank::new("bench", positions);
+    bank.modes = (0..256)
+        .map(|i| Mode {
+            freq_hz: 60.0 * (1.0 + i as f64 * 0.37),
+            decay_per_s: 0.2,
+            gains: vec![1.0 / (1.0 + i as f64)],
+        })
+        .collect();
+    bank.root_hz = Some(60.0);
+    let prepared = Arc::new(PreparedBank::new(&bank));
+    let seconds = 10.0;
+    let mut best = f64::INFINITY;
+    let mut live = 0;
+    for _ in 0..REPEATS {
+        let mut engine = Engine::new(prepared.clone());
+        engine.prepare(RATE_HZ as f32, BLOCK);
+        engine.set_kernel(kernel);
+        let mut controls = engine.controls().clone();
+        controls.truncation_db = -140.0;
+        engine.set_controls(&controls);
+        // Keys 24..40 keep every mode below 0.45 fs.
+        let notes: Vec<NoteEvent> = (0..16)
+            .map(|i| NoteEvent::On {
+                time: 0,
+                key: 24 + i,
+                velocity: 1.0,
+            })
+            .collect();
+        let (mut l, mut r) = (vec![0.0f32; BLOCK], vec![0.0f32; BLOCK]);
+        engine.process(&notes, None, &mut l, &mut r);
+        let blocks = (seconds * RATE_HZ) as usize / BLOCK;
+        let start = Instant::now();
+        for _ in 0..blocks {
+            engine.process(&[], None, &mut l, &mut r);
+            black_box((&mut l, &mut r));
+        }
+        best = best.min(start.elapsed().as_secs_f64());
+        live = engine.stats().live_modes;
+    }
+    (seconds / best, live)
+}
+
+fn main() {
+    // `cargo test --benches` runs this with --bench absent; keep that quick.
+    let quick = !std::env::args().any(|a| a == "--bench");
+    let work = if quick { WORK >> 8 } else { WORK };
+    let kernels: Vec<Kernel> = Kernel::ALL
+        .into_iter()
+        .filter(|k| k.is_supported())
+        .collect();
+    println!(
+        "Resonator kernels, mode-samples per second (one core, {BLOCK}-sample blocks, no input):"
+    );
+    print!("{:>8}", "modes");
+    for k in &kernels {
+        print!("{:>14}", k.name());
+    }
+    println!("{:>12}{:>12}", "avx2/scalar", "best/scalar");
+    for &n in &[64usize, 256, 1024, 4096, 16384] {
+        print!("{n:>8}");
+        let mut figures = Vec::new();
+        for &k in &kernels {
+            let w = if k == Kernel::Scalar { work / 8 } else { work };
+            let v = mode_samples_per_s(k, n, w);
+            figures.push((k, v));
+            print!("{:>14.3e}", v);
+        }
+        let of = |k| figures.iter().find(|(kk, _)| *kk == k).map(|f| f.1);
+        let scalar = of(Kernel::Scalar).unwrap();
+        let best = figures.iter().map(|f| f.1).fold(0.0, f64::max);
+        match of(Kernel::Avx2) {
+            Some(a) => print!("{:>12.1}", a / scalar),
+            None => print!("{:>12}", "-"),
+        }
+        println!("{:>12.1}", best / scalar);
+    }
+    println!();
+    println!("Engine, 16 voices x 256 modes, 48 kHz, {BLOCK}-sample blocks:");
+    for &k in &kernels {
+        let (rt, live) = engine_realtime_factor(k);
+        println!(
+            "  {:<10} real-time factor {:>8.1}x  ({live} live modes)",
+            k.name(),
+            rt
+        );
+    }
+}

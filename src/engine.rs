@@ -1,1 +1,305 @@
-//! Voices and routing: the single entry used by the plugin, the renderer, tests and benches.
+//! Voices and routing: the single entry used by the plugin, the renderer, the tests and the
+//! benchmarks.
+//!
+//! # Lifecycle
+//! - [`Engine::new`] is cheap and allocates no voices.
+//! - [`Engine::prepare`] sizes everything for a sample rate and allocates.
+//! - [`Engine::set_bank`] swaps the bank, reusing storage when it is large enough.
+//! - [`Engine::reset`] silences every voice without allocating.
+//! - [`Engine::process`] never allocates, locks, logs or does I/O.
+//!
+//! # Timing
+//! Control values are smoothed and applied on a fixed grid of [`CONTROL_PERIOD`] samples counted
+//! from the last reset, and note events land on their exact sample, so the output does not depend
+//! on how the host cuts the stream into blocks.
+
+mod controls;
+mod position;
+mod prepared;
+mod stereo;
+mod voice;
+
+use std::sync::Arc;
+
+pub use controls::{
+    ControlSpec, Controls, Material, MATERIAL_Q_RANGE, MAX_POLYPHONY, NUMERIC_CONTROLS,
+};
+pub use position::{PositionMap, PositionWeights};
+pub use prepared::{PreparedBank, TARGET_PEAK};
+use stereo::lane_weights;
+use voice::{Tuning, Voice, VoiceState};
+
+use crate::dsp::coeffs::{db_to_gain, t60_to_decay};
+use crate::dsp::denormal::FlushDenormals;
+use crate::dsp::rng::Rng;
+use crate::dsp::{Kernel, COLUMNS};
+
+/// Samples between control updates: smoothing steps, coefficient updates and mode truncation.
+pub const CONTROL_PERIOD: usize = 64;
+
+/// Voices beyond the polyphony limit, used by stolen voices while they fade.
+const FADE_SLOTS: usize = 8;
+
+/// How long a stolen voice fades, in seconds.
+const STEAL_FADE_S: f64 = 0.005;
+
+/// Time constant of pitch smoothing, in seconds: a 2-semitone bend in 10 ms is followed closely.
+const PITCH_SMOOTHING_S: f64 = 0.002;
+
+/// Time constant of material (Q, tilt) smoothing, in seconds.
+const DAMPING_SMOOTHING_S: f64 = 0.02;
+
+/// Time constant of output gain smoothing, in seconds.
+const GAIN_SMOOTHING_S: f64 = 0.01;
+
+/// Seed of the engine's random numbers (strike variation, noise), restored by `reset`.
+const SEED: u32 = 0x5EED_0001;
+
+/// A note event at a sample offset within the block passed to [`Engine::process`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum NoteEvent {
+    /// Strike `key` with `velocity` (0 to 1; 0 acts as a note-off).
+    On { time: u32, key: u8, velocity: f32 },
+    /// Release `key`.
+    Off { time: u32, key: u8 },
+    /// Release every key (MIDI CC 123).
+    AllNotesOff { time: u32 },
+    /// Silence every voice at once (MIDI CC 120).
+    AllSoundOff { time: u32 },
+}
+
+impl NoteEvent {
+    /// Sample offset of the event within its block.
+    pub fn time(&self) -> u32 {
+        match *self {
+            NoteEvent::On { time, .. }
+            | NoteEvent::Off { time, .. }
+            | NoteEvent::AllNotesOff { time }
+            | NoteEvent::AllSoundOff { time } => time,
+        }
+    }
+}
+
+/// What the engine is doing, for meters.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct EngineStats {
+    /// Voices sounding (not counting fading or input voices).
+    pub voices: usize,
+    /// Modes above the truncation threshold, over all voices.
+    pub live_modes: usize,
+    /// Modes the kernels advance per sample (live modes plus row padding).
+    pub computed_modes: usize,
+}
+
+/// Smoothed values and ramps that change on control ticks.
+#[derive(Debug, Clone)]
+struct Smoothed {
+    /// Natural log of the decay multiplier `Q_ref / Q`.
+    log_damping: f64,
+    /// Damping tilt.
+    tilt: f64,
+    /// Output gain, linear, smoothed per sample.
+    gain: f32,
+    /// Left and right column weights now.
+    weights: ([f32; COLUMNS], [f32; COLUMNS]),
+    /// Per-sample change of the weights while ramping.
+    weight_step: ([f32; COLUMNS], [f32; COLUMNS]),
+    /// Samples left in the weight ramp.
+    weight_ramp_left: usize,
+}
+
+/// The modal synthesis engine.
+pub struct Engine {
+    /// The bank being played.
+    bank: Arc<PreparedBank>,
+    /// Control targets, sanitised.
+    controls: Controls,
+    /// Resonator implementation.
+    kernel: Kernel,
+    /// Sample rate in Hz.
+    sample_rate_hz: f64,
+    /// Voice pool: `MAX_POLYPHONY + FADE_SLOTS` once prepared.
+    voices: Vec<Voice>,
+    /// The voice driven by the audio input.
+    input_voice: Option<Voice>,
+    /// Whether the input voice has had non-silent input since the last control tick.
+    input_heard: bool,
+    /// Damped decay rate of each mode at the smoothed material, before pitch scaling.
+    decay: Vec<f64>,
+    /// Incremented whenever `decay` changes.
+    damping_version: u64,
+    /// Smoothed controls.
+    smoothed: Smoothed,
+    /// Samples since reset.
+    clock: u64,
+    /// Voices allocated so far, for ages.
+    allocations: u64,
+    /// The last key struck, which tunes the input voice.
+    last_key: Option<u8>,
+    /// Strike position variation.
+    rng: Rng,
+    /// Per-sample column sums of the current run.
+    acc: Vec<[f32; COLUMNS]>,
+    /// Column sums of one fading voice.
+    fade_acc: Vec<[f32; COLUMNS]>,
+    /// Excitation of one voice for the current run.
+    excitation: Vec<f32>,
+}
+
+impl Engine {
+    /// An engine for `bank` with its default controls. Cheap: voices are allocated by
+    /// [`Engine::prepare`].
+    pub fn new(bank: Arc<PreparedBank>) -> Self {
+        let controls = Controls::for_bank(&bank.source);
+        let smoothed = Smoothed {
+            log_damping: 0.0,
+            tilt: 0.0,
+            gain: 1.0,
+            weights: lane_weights(controls.width),
+            weight_step: ([0.0; COLUMNS], [0.0; COLUMNS]),
+            weight_ramp_left: 0,
+        };
+        Self {
+            bank,
+            controls,
+            kernel: Kernel::from_env_or_detect(),
+            sample_rate_hz: 48_000.0,
+            voices: Vec::new(),
+            input_voice: None,
+            input_heard: false,
+            decay: Vec::new(),
+            damping_version: 0,
+            smoothed,
+            clock: 0,
+            allocations: 0,
+            last_key: None,
+            rng: Rng::new(SEED),
+            acc: Vec::new(),
+            fade_acc: Vec::new(),
+            excitation: Vec::new(),
+        }
+    }
+
+    /// Sizes everything for `sample_rate_hz` and resets. Allocates. Blocks of any length can be
+    /// processed afterwards; `_max_block` is accepted for hosts that announce it.
+    pub fn prepare(&mut self, sample_rate_hz: f32, _max_block: usize) {
+        assert!(
+            sample_rate_hz.is_finite() && sample_rate_hz >= 8_000.0,
+            "sample rate {sample_rate_hz} Hz is not supported"
+        );
+        self.sample_rate_hz = sample_rate_hz as f64;
+        self.acc = vec![[0.0; COLUMNS]; CONTROL_PERIOD];
+        self.fade_acc = vec![[0.0; COLUMNS]; CONTROL_PERIOD];
+        self.excitation = vec![0.0; CONTROL_PERIOD];
+        self.allocate_voices();
+        self.reset();
+    }
+
+    /// Plays `bank` from now on, silencing every voice. Allocates only when the bank has more
+    /// modes than the voices can hold. Call it off the audio thread, or with storage known to fit.
+    pub fn set_bank(&mut self, bank: Arc<PreparedBank>) {
+        self.bank = bank;
+        let fits = self
+            .voices
+            .first()
+            .is_some_and(|v| v.modes.num_modes() >= self.bank.num_modes());
+        if !self.voices.is_empty() && !fits {
+            self.allocate_voices();
+        } else {
+            for v in self.voices.iter_mut().chain(self.input_voice.as_mut()) {
+                v.free();
+            }
+        }
+        self.decay.resize(self.bank.num_modes(), 0.0);
+        self.rebuild_decay_table();
+    }
+
+    fn allocate_voices(&mut self) {
+        let n = self.bank.num_modes();
+        self.voices = (0..MAX_POLYPHONY + FADE_SLOTS)
+            .map(|i| Voice::new(n, SEED ^ (i as u32 + 1)))
+            .collect();
+        self.input_voice = Some(Voice::new(n, SEED ^ 0xFFFF));
+        self.decay = vec![0.0; n];
+    }
+
+    /// Silences every voice and restarts smoothing and random sequences. Does not allocate.
+    pub fn reset(&mut self) {
+        for v in self.voices.iter_mut().chain(self.input_voice.as_mut()) {
+            v.free();
+        }
+        self.clock = 0;
+        self.allocations = 0;
+        self.last_key = None;
+        self.input_heard = false;
+        self.rng = Rng::new(SEED);
+        let (log_damping, tilt) = self.damping_targets();
+        self.smoothed = Smoothed {
+            log_damping,
+            tilt,
+            gain: db_to_gain(self.controls.output_gain_db),
+            weights: lane_weights(self.controls.width),
+            weight_step: ([0.0; COLUMNS], [0.0; COLUMNS]),
+            weight_ramp_left: 0,
+        };
+        self.rebuild_decay_table();
+    }
+
+    /// The bank being played.
+    pub fn bank(&self) -> &Arc<PreparedBank> {
+        &self.bank
+    }
+
+    /// The control targets.
+    pub fn controls(&self) -> &Controls {
+        &self.controls
+    }
+
+    /// Sets the control targets (sanitised: out-of-range values are clamped, NaN takes the
+    /// default). Changes are smoothed from the next control tick. Does not allocate.
+    pub fn set_controls(&mut self, controls: &Controls) {
+        self.controls.clone_from(controls);
+        self.controls = self.controls.sanitized();
+    }
+
+    /// The resonator implementation in use.
+    pub fn kernel(&self) -> Kernel {
+        self.kernel
+    }
+
+    /// Uses `kernel` from now on (it must be supported by this CPU).
+    pub fn set_kernel(&mut self, kernel: Kernel) {
+        assert!(
+            kernel.is_supported(),
+            "kernel {} is not supported here",
+            kernel.name()
+        );
+        self.kernel = kernel;
+    }
+
+    /// Sample rate in Hz.
+    pub fn sample_rate_hz(&self) -> f32 {
+        self.sample_rate_hz as f32
+    }
+
+    /// Meters.
+    pub fn stats(&self) -> EngineStats {
+        let mut s = EngineStats::default();
+        for v in self.voices.iter().chain(self.input_voice.as_ref()) {
+            s.voices += v.is_sounding() as usize;
+            s.live_modes += v.modes.num_live();
+            s.computed_modes += v.modes.num_computed();
+        }
+        s
+    }
+
+    /// Whether nothing sounds and nothing is about to.
+    pub fn is_silent(&self) -> bool {
+        self.voices
+            .iter()
+            .chain(self.input_voice.as_ref())
+            .all(|v| v.state == VoiceState::Free && v.modes.num_live() == 0)
+    }
+}
+
+mod process;

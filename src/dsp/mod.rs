@@ -1,1 +1,17 @@
-//! Real-time signal processing: no plugin framework, no allocation after `prepare`.
+//! Real-time signal processing.
+//!
+//! Nothing here imports the plugin framework. Everything takes plain slices in natural units at a
+//! documented sample rate. Storage is sized in `new`/`prepare` style constructors; the per-sample
+//! paths never allocate.
+
+pub mod coeffs;
+pub mod denormal;
+pub mod exciter;
+pub mod kernels;
+pub mod resonator_bank;
+pub mod rng;
+
+pub use coeffs::ModeCoeffs;
+pub use exciter::{Exciter, ExciterKind};
+pub use kernels::Kernel;
+pub use resonator_bank::{ResonatorBank, COLUMNS};

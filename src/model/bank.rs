@@ -115,3 +115,46 @@ impl Bank {
         self.positions.len()
     }
 }
+
+/// Modes within this many dB of the strongest count as "strongest" when choosing a default root.
+const ROOT_STRENGTH_DB: f64 = 6.0;
+
+impl Bank {
+    /// The pitch the bank sounds at size 1: `root_hz` when given, else the lowest of the modes
+    /// within 6 dB of the strongest (strength: largest gain over the positions).
+    pub fn effective_root_hz(&self) -> f64 {
+        if let Some(root) = self.root_hz {
+            return root;
+        }
+        let strength = |m: &Mode| m.gains.iter().fold(0.0f64, |a, g| a.max(g.abs()));
+        let strongest = self.modes.iter().map(strength).fold(0.0, f64::max);
+        let floor = strongest * 10f64.powf(-ROOT_STRENGTH_DB / 20.0);
+        self.modes
+            .iter()
+            .filter(|m| strength(m) >= floor)
+            .map(|m| m.freq_hz)
+            .fold(f64::INFINITY, f64::min)
+            .min(1e6)
+    }
+
+    /// The bank's own quality factor: the median of `pi f / d` over the modes that decay, or
+    /// `None` when none does. Material Q scales decays relative to it.
+    pub fn reference_q(&self) -> Option<f64> {
+        let mut qs: Vec<f64> = self
+            .modes
+            .iter()
+            .filter(|m| m.decay_per_s > 0.0)
+            .map(|m| std::f64::consts::PI * m.freq_hz / m.decay_per_s)
+            .collect();
+        if qs.is_empty() {
+            return None;
+        }
+        qs.sort_by(f64::total_cmp);
+        let mid = qs.len() / 2;
+        Some(if qs.len() % 2 == 1 {
+            qs[mid]
+        } else {
+            0.5 * (qs[mid - 1] + qs[mid])
+        })
+    }
+}

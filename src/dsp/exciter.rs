@@ -1,0 +1,228 @@
+//! What strikes the resonators: impulses, mallet force pulses and noise bursts.
+//!
+//! Each strike becomes a short input signal of unit area (impulse, mallet) or unit energy (noise)
+//! times its amplitude, so a mode's response to it has the mode's own amplitude for an impulse.
+//! Several strikes may overlap on one voice; their pulses add.
+
+use std::f32::consts::TAU;
+
+use super::rng::Rng;
+
+/// How many overlapping strikes one voice keeps; a further strike replaces the oldest.
+const MAX_PULSES: usize = 4;
+
+/// The shape of a strike.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ExciterKind {
+    /// A single sample: every mode at its full amplitude.
+    Impulse,
+    /// Raised-cosine force pulse `1 - cos(2 pi t / T)` over the contact time T (van den Doel,
+    /// seed 000 eq. 4.5): short T is a hard, bright mallet, long T a soft, dull one.
+    #[default]
+    Mallet,
+    /// White noise under a linearly falling envelope over the contact time: a scrape or brush.
+    Noise,
+}
+
+impl ExciterKind {
+    /// Every kind, for parameter lists.
+    pub const ALL: [ExciterKind; 3] = [
+        ExciterKind::Impulse,
+        ExciterKind::Mallet,
+        ExciterKind::Noise,
+    ];
+
+    /// Lowercase name.
+    pub fn name(self) -> &'static str {
+        match self {
+            ExciterKind::Impulse => "impulse",
+            ExciterKind::Mallet => "mallet",
+            ExciterKind::Noise => "noise",
+        }
+    }
+
+    /// The kind with this lowercase name.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+
+    /// Bound on a mode's amplitude after a strike of unit amplitude, relative to its gain: 1 for
+    /// unit-area pulses; for noise of `len` samples and unit energy, `sqrt(len)` (Cauchy-Schwarz).
+    pub fn peak_bound(self, len_samples: u32) -> f32 {
+        match self {
+            ExciterKind::Impulse | ExciterKind::Mallet => 1.0,
+            ExciterKind::Noise => (len_samples.max(1) as f32).sqrt(),
+        }
+    }
+}
+
+/// One strike in progress.
+#[derive(Debug, Clone, Copy)]
+struct Pulse {
+    /// Shape of the pulse.
+    kind: ExciterKind,
+    /// Scale of the pulse: its area (impulse, mallet) or the square root of its energy (noise).
+    amplitude: f32,
+    /// Length in samples.
+    len: u32,
+    /// Samples already emitted.
+    pos: u32,
+    /// Noise scale making the burst's energy `amplitude^2`.
+    noise_scale: f32,
+}
+
+/// The strikes under way on one voice.
+#[derive(Debug, Clone)]
+pub struct Exciter {
+    /// Active pulses; the first `count` are in use.
+    pulses: [Pulse; MAX_PULSES],
+    /// Number of active pulses.
+    count: usize,
+    /// Noise source, reseeded on reset so output repeats.
+    rng: Rng,
+    /// Seed restored by `reset`.
+    seed: u32,
+}
+
+impl Exciter {
+    /// An idle exciter whose noise starts from `seed`.
+    pub fn new(seed: u32) -> Self {
+        let idle = Pulse {
+            kind: ExciterKind::Impulse,
+            amplitude: 0.0,
+            len: 0,
+            pos: 0,
+            noise_scale: 0.0,
+        };
+        Self {
+            pulses: [idle; MAX_PULSES],
+            count: 0,
+            rng: Rng::new(seed),
+            seed,
+        }
+    }
+
+    /// Drops every pulse and restarts the noise sequence.
+    pub fn reset(&mut self) {
+        self.count = 0;
+        self.rng = Rng::new(self.seed);
+    }
+
+    /// Whether no strike is under way.
+    pub fn is_idle(&self) -> bool {
+        self.count == 0
+    }
+
+    /// Starts a strike of `amplitude` lasting `len_samples` (at least 1) from the next sample
+    /// rendered.
+    pub fn strike(&mut self, kind: ExciterKind, amplitude: f32, len_samples: u32) {
+        let len = if kind == ExciterKind::Impulse {
+            1
+        } else {
+            len_samples.max(1)
+        };
+        // Linear envelope (1 - n/len): sum of squares ~ len / 3; uniform noise has variance 1/3.
+        let env_energy: f32 = (0..len)
+            .map(|n| (1.0 - n as f32 / len as f32).powi(2))
+            .sum();
+        let noise_scale = (3.0 / env_energy.max(1e-9)).sqrt();
+        let pulse = Pulse {
+            kind,
+            amplitude,
+            len,
+            pos: 0,
+            noise_scale,
+        };
+        if self.count < MAX_PULSES {
+            self.pulses[self.count] = pulse;
+            self.count += 1;
+        } else {
+            self.pulses.rotate_left(1);
+            self.pulses[MAX_PULSES - 1] = pulse;
+        }
+    }
+
+    /// Writes the excitation for the next `out.len()` samples into `out` (overwriting it).
+    /// Returns whether any pulse contributed.
+    pub fn render(&mut self, out: &mut [f32]) -> bool {
+        if self.count == 0 {
+            return false;
+        }
+        out.fill(0.0);
+        let mut i = 0;
+        while i < self.count {
+            let p = &mut self.pulses[i];
+            let n = ((p.len - p.pos) as usize).min(out.len());
+            match p.kind {
+                ExciterKind::Impulse => {
+                    if n > 0 {
+                        out[0] += p.amplitude;
+                    }
+                }
+                ExciterKind::Mallet => {
+                    if p.len == 1 {
+                        out[0] += p.amplitude;
+                    } else {
+                        // Raised cosine sampled at cell centres: sums to exactly `len`.
+                        let scale = p.amplitude / p.len as f32;
+                        let step = TAU / p.len as f32;
+                        for (k, x) in out[..n].iter_mut().enumerate() {
+                            let phase = (p.pos as usize + k) as f32 + 0.5;
+                            *x += scale * (1.0 - (step * phase).cos());
+                        }
+                    }
+                }
+                ExciterKind::Noise => {
+                    let inv_len = 1.0 / p.len as f32;
+                    for (k, x) in out[..n].iter_mut().enumerate() {
+                        let env = 1.0 - (p.pos as usize + k) as f32 * inv_len;
+                        *x += p.amplitude * p.noise_scale * env * self.rng.bipolar();
+                    }
+                }
+            }
+            p.pos += n as u32;
+            if p.pos >= p.len {
+                self.pulses.copy_within(i + 1..self.count, i);
+                self.count -= 1;
+            } else {
+                i += 1;
+            }
+        }
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn total(kind: ExciterKind, len: u32, block: usize) -> (f32, f32) {
+        let mut e = Exciter::new(7);
+        e.strike(kind, 0.5, len);
+        let mut sum = 0.0;
+        let mut energy = 0.0;
+        let mut buf = vec![0.0; block];
+        while e.render(&mut buf) {
+            sum += buf.iter().sum::<f32>();
+            energy += buf.iter().map(|x| x * x).sum::<f32>();
+        }
+        (sum, energy)
+    }
+
+    #[test]
+    fn pulses_have_unit_area_or_energy_whatever_the_block() {
+        for block in [1, 7, 64] {
+            let (area, _) = total(ExciterKind::Impulse, 10, block);
+            assert!((area - 0.5).abs() < 1e-6, "impulse area {area}");
+            for len in [1, 2, 48, 960] {
+                let (area, _) = total(ExciterKind::Mallet, len, block);
+                assert!(
+                    (area - 0.5).abs() < 1e-4,
+                    "mallet len {len} block {block}: area {area}"
+                );
+            }
+            let (_, energy) = total(ExciterKind::Noise, 4800, block);
+            assert!((energy / 0.25 - 1.0).abs() < 0.1, "noise energy {energy}");
+        }
+    }
+}

@@ -1,0 +1,367 @@
+//! The engine's controls: plain values in natural units, with their ranges, defaults and names in
+//! one table shared by the plugin's parameters, the command line and the tests.
+
+use crate::dsp::ExciterKind;
+use crate::model::Bank;
+
+/// Most voices the engine can play at once.
+pub const MAX_POLYPHONY: usize = 64;
+
+/// A material shortcut: sets material Q and damping tilt together.
+///
+/// Q values span the useful range seed 004 section 5.1.2 found by listening (about 20 for plastic
+/// to 5000 for metal); the tilt lets high modes die faster in lossy materials (wood's internal
+/// friction grows with frequency) and ring on in metal.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Material {
+    /// Dull, short knock.
+    Plastic,
+    /// Warm, short ring, highs die first.
+    Wood,
+    /// Bright clink.
+    Ceramic,
+    /// Clear, long ring.
+    Glass,
+    /// Long, shimmering ring.
+    Metal,
+}
+
+impl Material {
+    /// Every shortcut, from most to least damped.
+    pub const ALL: [Material; 5] = [
+        Material::Plastic,
+        Material::Wood,
+        Material::Ceramic,
+        Material::Glass,
+        Material::Metal,
+    ];
+
+    /// Lowercase name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Material::Plastic => "plastic",
+            Material::Wood => "wood",
+            Material::Ceramic => "ceramic",
+            Material::Glass => "glass",
+            Material::Metal => "metal",
+        }
+    }
+
+    /// The material with this lowercase name.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// Quality factor Q = pi f / d.
+    pub fn q(self) -> f32 {
+        match self {
+            Material::Plastic => 40.0,
+            Material::Wood => 120.0,
+            Material::Ceramic => 900.0,
+            Material::Glass => 2000.0,
+            Material::Metal => 5000.0,
+        }
+    }
+
+    /// Damping tilt: decays scale by `(f / f_lowest) ^ tilt`.
+    pub fn damping_tilt(self) -> f32 {
+        match self {
+            Material::Plastic => 0.4,
+            Material::Wood => 0.7,
+            Material::Ceramic => 0.2,
+            Material::Glass => 0.1,
+            Material::Metal => -0.1,
+        }
+    }
+}
+
+/// Every control of the engine.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Controls {
+    /// Material quality factor; `None` plays the bank's decays as authored.
+    pub material_q: Option<f32>,
+    /// Decays scale by `(f / f_lowest) ^ damping_tilt`: positive damps high modes.
+    pub damping_tilt: f32,
+    /// Object size relative to the bank; frequencies divide by it.
+    pub size_ratio: f32,
+    /// How far pitch follows the MIDI key, 0 (not at all) to 1 (equal temperament).
+    pub key_tracking: f32,
+    /// Fine tuning in cents.
+    pub fine_tune_cents: f32,
+    /// Current pitch bend in semitones (the plugin scales the wheel by its bend range).
+    pub pitch_bend_semitones: f32,
+    /// Strike position along the bank's positions, 0 to 1 (first axis of 2-D banks).
+    pub strike_x: f32,
+    /// Strike position on the second axis of 2-D banks, 0 to 1.
+    pub strike_y: f32,
+    /// Random change of the strike position per strike, as a fraction of the range.
+    pub position_variation: f32,
+    /// Shape of a strike.
+    pub exciter: ExciterKind,
+    /// Mallet contact time at full velocity in ms: short is hard and bright.
+    pub hardness_ms: f32,
+    /// How much velocity sets strike force: 0 = every note at full force, 1 = force ~ velocity^2.
+    pub velocity_sensitivity: f32,
+    /// How much softer notes lengthen the contact time (up to 4x at velocity 0).
+    pub velocity_to_hardness: f32,
+    /// Damping applied on note-off: 0 lets the object ring on, 1 damps it within about 50 ms.
+    pub release_damping: f32,
+    /// A mode stops being computed once its amplitude is below this level, in dBFS.
+    pub truncation_db: f32,
+    /// Voices that may sound at once.
+    pub polyphony: usize,
+    /// Stereo spread of the modes, 0 (mono) to 1 (full width).
+    pub width: f32,
+    /// Output level in dB.
+    pub output_gain_db: f32,
+    /// Level of an audio input driving the modes, in dB.
+    pub input_gain_db: f32,
+}
+
+impl Default for Controls {
+    fn default() -> Self {
+        Self {
+            material_q: None,
+            damping_tilt: 0.0,
+            size_ratio: 1.0,
+            key_tracking: 1.0,
+            fine_tune_cents: 0.0,
+            pitch_bend_semitones: 0.0,
+            strike_x: 0.0,
+            strike_y: 0.0,
+            position_variation: 0.0,
+            exciter: ExciterKind::Mallet,
+            hardness_ms: 0.25,
+            velocity_sensitivity: 0.8,
+            velocity_to_hardness: 0.5,
+            release_damping: 0.0,
+            truncation_db: -96.0,
+            polyphony: 16,
+            width: 0.5,
+            output_gain_db: 0.0,
+            input_gain_db: 0.0,
+        }
+    }
+}
+
+/// A numeric control: its name on the command line, unit, range and default.
+pub struct ControlSpec {
+    /// Name used by `--set name=value`.
+    pub name: &'static str,
+    /// Unit shown next to the value.
+    pub unit: &'static str,
+    /// Smallest value.
+    pub min: f32,
+    /// Largest value.
+    pub max: f32,
+    /// Reads the control.
+    pub get: fn(&Controls) -> f32,
+    /// Writes the control (the value is already clamped to the range).
+    pub set: fn(&mut Controls, f32),
+}
+
+macro_rules! spec {
+    ($name:literal, $unit:literal, $min:expr, $max:expr, $field:ident) => {
+        ControlSpec {
+            name: $name,
+            unit: $unit,
+            min: $min,
+            max: $max,
+            get: |c| c.$field as f32,
+            set: |c, v| c.$field = v as _,
+        }
+    };
+}
+
+/// The numeric controls. `material_q`, `material` and `exciter` are handled by name in
+/// [`Controls::set_by_name`] since they are not plain numbers.
+pub const NUMERIC_CONTROLS: &[ControlSpec] = &[
+    spec!("damping_tilt", "", -2.0, 2.0, damping_tilt),
+    spec!("size_ratio", "x", 0.25, 4.0, size_ratio),
+    spec!("key_tracking", "", 0.0, 1.0, key_tracking),
+    spec!("fine_tune_cents", "ct", -100.0, 100.0, fine_tune_cents),
+    spec!(
+        "pitch_bend_semitones",
+        "st",
+        -48.0,
+        48.0,
+        pitch_bend_semitones
+    ),
+    spec!("strike_x", "", 0.0, 1.0, strike_x),
+    spec!("strike_y", "", 0.0, 1.0, strike_y),
+    spec!("position_variation", "", 0.0, 1.0, position_variation),
+    spec!("hardness_ms", "ms", 0.05, 20.0, hardness_ms),
+    spec!("velocity_sensitivity", "", 0.0, 1.0, velocity_sensitivity),
+    spec!("velocity_to_hardness", "", 0.0, 1.0, velocity_to_hardness),
+    spec!("release_damping", "", 0.0, 1.0, release_damping),
+    spec!("truncation_db", "dBFS", -140.0, -60.0, truncation_db),
+    spec!("polyphony", "voices", 1.0, MAX_POLYPHONY as f32, polyphony),
+    spec!("width", "", 0.0, 1.0, width),
+    spec!("output_gain_db", "dB", -60.0, 12.0, output_gain_db),
+    spec!("input_gain_db", "dB", -60.0, 24.0, input_gain_db),
+];
+
+/// Range of material Q.
+pub const MATERIAL_Q_RANGE: (f32, f32) = (1.0, 100_000.0);
+
+impl Controls {
+    /// The defaults, with the bank's own `defaults` applied.
+    pub fn for_bank(bank: &Bank) -> Self {
+        let mut c = Self::default();
+        if let Some(d) = &bank.defaults {
+            if let Some(q) = d.material_q {
+                c.material_q = Some(q as f32);
+            }
+            if let Some(t) = d.damping_tilt {
+                c.damping_tilt = t as f32;
+            }
+            if let Some(h) = d.hardness_ms {
+                c.hardness_ms = h as f32;
+            }
+            if let Some(p) = d.strike_position {
+                c.strike_x = p as f32;
+            }
+            if let Some(k) = d.key_tracking_pct {
+                c.key_tracking = (k / 100.0) as f32;
+            }
+        }
+        c.sanitized()
+    }
+
+    /// Applies a material shortcut.
+    pub fn set_material(&mut self, material: Material) {
+        self.material_q = Some(material.q());
+        self.damping_tilt = material.damping_tilt();
+    }
+
+    /// Every value within its range; a value that is not a number takes its default.
+    pub fn sanitized(&self) -> Self {
+        let defaults = Self::default();
+        let mut c = self.clone();
+        for spec in NUMERIC_CONTROLS {
+            let v = (spec.get)(&c);
+            let v = if v.is_nan() {
+                (spec.get)(&defaults)
+            } else {
+                v.clamp(spec.min, spec.max)
+            };
+            (spec.set)(&mut c, v);
+        }
+        c.material_q = c
+            .material_q
+            .filter(|q| !q.is_nan())
+            .map(|q| q.clamp(MATERIAL_Q_RANGE.0, MATERIAL_Q_RANGE.1));
+        c
+    }
+
+    /// Sets a control from text, as in `--set name=value`: any numeric control,
+    /// `material_q` (a number or `authored`), `material` (plastic, wood, ceramic, glass, metal)
+    /// or `exciter` (impulse, mallet, noise). Values outside a range are errors, not clamped.
+    pub fn set_by_name(&mut self, name: &str, value: &str) -> Result<(), String> {
+        let value = value.trim();
+        match name {
+            "material" => {
+                let m = Material::from_name(value).ok_or_else(|| {
+                    let names: Vec<_> = Material::ALL.iter().map(|m| m.name()).collect();
+                    format!(
+                        "material: expected one of {}, found \"{value}\"",
+                        names.join(", ")
+                    )
+                })?;
+                self.set_material(m);
+                Ok(())
+            }
+            "exciter" => {
+                self.exciter = ExciterKind::from_name(value).ok_or_else(|| {
+                    let names: Vec<_> = ExciterKind::ALL.iter().map(|k| k.name()).collect();
+                    format!(
+                        "exciter: expected one of {}, found \"{value}\"",
+                        names.join(", ")
+                    )
+                })?;
+                Ok(())
+            }
+            "material_q" if value == "authored" => {
+                self.material_q = None;
+                Ok(())
+            }
+            "material_q" => {
+                let q = parse_in_range(name, value, MATERIAL_Q_RANGE.0, MATERIAL_Q_RANGE.1)?;
+                self.material_q = Some(q);
+                Ok(())
+            }
+            _ => {
+                let spec = NUMERIC_CONTROLS
+                    .iter()
+                    .find(|s| s.name == name)
+                    .ok_or_else(|| {
+                        let mut names: Vec<_> = NUMERIC_CONTROLS.iter().map(|s| s.name).collect();
+                        names.extend(["material_q", "material", "exciter"]);
+                        format!(
+                            "unknown control \"{name}\"; known controls: {}",
+                            names.join(", ")
+                        )
+                    })?;
+                let v = parse_in_range(name, value, spec.min, spec.max)?;
+                (spec.set)(self, v);
+                Ok(())
+            }
+        }
+    }
+}
+
+fn parse_in_range(name: &str, value: &str, min: f32, max: f32) -> Result<f32, String> {
+    let v: f32 = value
+        .parse()
+        .map_err(|_| format!("{name}: expected a number from {min} to {max}, found \"{value}\""))?;
+    if !(min..=max).contains(&v) {
+        return Err(format!(
+            "{name}: expected a number from {min} to {max}, found {v}"
+        ));
+    }
+    Ok(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sanitizing_clamps_and_replaces_nan() {
+        let c = Controls {
+            size_ratio: f32::NAN,
+            width: 7.0,
+            truncation_db: -1e9,
+            material_q: Some(f32::INFINITY),
+            ..Controls::default()
+        }
+        .sanitized();
+        assert_eq!(c.size_ratio, 1.0);
+        assert_eq!(c.width, 1.0);
+        assert_eq!(c.truncation_db, -140.0);
+        assert_eq!(c.material_q, Some(MATERIAL_Q_RANGE.1));
+    }
+
+    #[test]
+    fn set_by_name_reports_range_and_names() {
+        let mut c = Controls::default();
+        c.set_by_name("material_q", "800").unwrap();
+        assert_eq!(c.material_q, Some(800.0));
+        c.set_by_name("material", "wood").unwrap();
+        assert_eq!(c.material_q, Some(Material::Wood.q()));
+        assert!(c
+            .set_by_name("size_ratio", "9")
+            .unwrap_err()
+            .contains("0.25 to 4"));
+        assert!(c
+            .set_by_name("sise_ratio", "1")
+            .unwrap_err()
+            .contains("unknown control"));
+        assert!(c
+            .set_by_name("exciter", "hammer")
+            .unwrap_err()
+            .contains("impulse, mallet, noise"));
+        c.set_by_name("polyphony", "8").unwrap();
+        assert_eq!(c.polyphony, 8);
+    }
+}

@@ -1,0 +1,210 @@
+//! Strike positions between the measured ones: which gain columns to blend, and how much.
+
+/// At most this many positions are blended (a triangle on 2-D banks).
+pub const MAX_BLEND: usize = 3;
+
+/// Weights of up to three gain columns for one strike point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PositionWeights {
+    /// Column indices; entries past `count` are unused.
+    pub index: [usize; MAX_BLEND],
+    /// Weights summing to 1; entries past `count` are zero.
+    pub weight: [f32; MAX_BLEND],
+    /// Number of columns used.
+    pub count: usize,
+}
+
+impl PositionWeights {
+    /// All weight on column `k`.
+    pub fn single(k: usize) -> Self {
+        Self {
+            index: [k, 0, 0],
+            weight: [1.0, 0.0, 0.0],
+            count: 1,
+        }
+    }
+}
+
+/// The bank's positions, normalised to the unit interval or square.
+#[derive(Debug, Clone)]
+pub struct PositionMap {
+    /// Normalised coordinates of each position (second value 0.5 on 1-D banks).
+    coords: Vec<[f64; 2]>,
+    /// 1 or 2.
+    dims: usize,
+}
+
+impl PositionMap {
+    /// Normalises `coords` (each 1 or 2 values) per axis to 0..1 over their bounding box; an axis
+    /// on which every position agrees maps to 0.5.
+    pub fn new(coords: &[Vec<f64>]) -> Self {
+        let dims = coords
+            .iter()
+            .map(|c| c.len())
+            .max()
+            .unwrap_or(1)
+            .clamp(1, 2);
+        let mut out = vec![[0.5; 2]; coords.len()];
+        for axis in 0..dims {
+            let values = coords.iter().map(|c| c.get(axis).copied().unwrap_or(0.0));
+            let (lo, hi) = values
+                .clone()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                    (lo.min(v), hi.max(v))
+                });
+            for (o, v) in out.iter_mut().zip(values) {
+                o[axis] = if hi > lo { (v - lo) / (hi - lo) } else { 0.5 };
+            }
+        }
+        Self { coords: out, dims }
+    }
+
+    /// Number of coordinates per position.
+    pub fn dims(&self) -> usize {
+        self.dims
+    }
+
+    /// Normalised coordinates of each position.
+    pub fn coords(&self) -> &[[f64; 2]] {
+        &self.coords
+    }
+
+    /// The blend of columns for a strike at `(x, y)` (normalised; `y` ignored on 1-D banks).
+    ///
+    /// 1-D: linear between the neighbours on either side, the end position beyond the ends.
+    /// 2-D: barycentric within the triangle of the three nearest positions, clamped to its edges.
+    pub fn weights(&self, x: f32, y: f32) -> PositionWeights {
+        let p = [x.clamp(0.0, 1.0) as f64, y.clamp(0.0, 1.0) as f64];
+        match (self.coords.len(), self.dims) {
+            (0 | 1, _) => PositionWeights::single(0),
+            (_, 1) => self.weights_1d(p[0]),
+            (2, _) => self.weights_segment(0, 1, p),
+            _ => self.weights_2d(p),
+        }
+    }
+
+    fn weights_1d(&self, x: f64) -> PositionWeights {
+        let mut below: Option<(usize, f64)> = None;
+        let mut above: Option<(usize, f64)> = None;
+        for (k, c) in self.coords.iter().enumerate() {
+            let v = c[0];
+            if v <= x && below.is_none_or(|(_, b)| v > b) {
+                below = Some((k, v));
+            }
+            if v >= x && above.is_none_or(|(_, a)| v < a) {
+                above = Some((k, v));
+            }
+        }
+        match (below, above) {
+            (Some((kb, vb)), Some((ka, va))) if ka != kb && va > vb => {
+                let t = ((x - vb) / (va - vb)) as f32;
+                Self::pair(kb, ka, t)
+            }
+            (Some((k, _)), _) | (None, Some((k, _))) => PositionWeights::single(k),
+            (None, None) => PositionWeights::single(0),
+        }
+    }
+
+    /// Weights `1 - t` on `a` and `t` on `b`.
+    fn pair(a: usize, b: usize, t: f32) -> PositionWeights {
+        PositionWeights {
+            index: [a, b, 0],
+            weight: [1.0 - t, t, 0.0],
+            count: 2,
+        }
+    }
+
+    /// Projection of `p` onto the segment between positions `a` and `b`.
+    fn weights_segment(&self, a: usize, b: usize, p: [f64; 2]) -> PositionWeights {
+        let (pa, pb) = (self.coords[a], self.coords[b]);
+        let d = [pb[0] - pa[0], pb[1] - pa[1]];
+        let len_sq = d[0] * d[0] + d[1] * d[1];
+        if len_sq <= 1e-18 {
+            return PositionWeights::single(a);
+        }
+        let t = (((p[0] - pa[0]) * d[0] + (p[1] - pa[1]) * d[1]) / len_sq).clamp(0.0, 1.0);
+        Self::pair(a, b, t as f32)
+    }
+
+    fn weights_2d(&self, p: [f64; 2]) -> PositionWeights {
+        let dist_sq = |k: usize| {
+            let c = self.coords[k];
+            (c[0] - p[0]).powi(2) + (c[1] - p[1]).powi(2)
+        };
+        // The three nearest positions, nearest first.
+        let mut near = [usize::MAX; MAX_BLEND];
+        for k in 0..self.coords.len() {
+            let mut item = k;
+            for slot in near.iter_mut() {
+                if *slot == usize::MAX || dist_sq(item) < dist_sq(*slot) {
+                    std::mem::swap(slot, &mut item);
+                    if item == usize::MAX {
+                        break;
+                    }
+                }
+            }
+        }
+        let [a, b, c] = near;
+        if dist_sq(a) <= 1e-18 {
+            return PositionWeights::single(a);
+        }
+        let (pa, pb, pc) = (self.coords[a], self.coords[b], self.coords[c]);
+        let det = (pb[1] - pc[1]) * (pa[0] - pc[0]) + (pc[0] - pb[0]) * (pa[1] - pc[1]);
+        if det.abs() < 1e-12 {
+            // Collinear: blend along the two nearest.
+            return self.weights_segment(a, b, p);
+        }
+        let wa = ((pb[1] - pc[1]) * (p[0] - pc[0]) + (pc[0] - pb[0]) * (p[1] - pc[1])) / det;
+        let wb = ((pc[1] - pa[1]) * (p[0] - pc[0]) + (pa[0] - pc[0]) * (p[1] - pc[1])) / det;
+        let wc = 1.0 - wa - wb;
+        let w = [wa.max(0.0), wb.max(0.0), wc.max(0.0)];
+        let sum: f64 = w.iter().sum();
+        if sum <= 0.0 {
+            return PositionWeights::single(a);
+        }
+        PositionWeights {
+            index: [a, b, c],
+            weight: [
+                (w[0] / sum) as f32,
+                (w[1] / sum) as f32,
+                (w[2] / sum) as f32,
+            ],
+            count: 3,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_dimension_interpolates_between_neighbours() {
+        let map = PositionMap::new(&[vec![0.5], vec![0.0], vec![0.25]]);
+        let w = map.weights(0.25, 0.0); // halfway between coords 0.0 and 0.25
+        assert_eq!(w.count, 2);
+        assert_eq!((w.index[0], w.index[1]), (1, 2));
+        assert!((w.weight[0] - 0.5).abs() < 1e-6 && (w.weight[1] - 0.5).abs() < 1e-6);
+        assert_eq!(map.weights(1.0, 0.0), PositionWeights::single(0));
+        assert_eq!(map.weights(0.0, 0.0), PositionWeights::single(1));
+    }
+
+    #[test]
+    fn two_dimensions_hit_positions_exactly_and_blend_inside() {
+        let map = PositionMap::new(&[
+            vec![0.0, 0.0],
+            vec![1.0, 0.0],
+            vec![0.0, 1.0],
+            vec![1.0, 1.0],
+        ]);
+        assert_eq!(map.weights(1.0, 1.0), PositionWeights::single(3));
+        let w = map.weights(0.2, 0.2);
+        let sum: f32 = w.weight.iter().sum();
+        assert!((sum - 1.0).abs() < 1e-6);
+        let mut at = [0.0f32; 4];
+        for i in 0..w.count {
+            at[w.index[i]] += w.weight[i];
+        }
+        assert!(at[0] > 0.5, "nearest corner dominates: {at:?}");
+    }
+}

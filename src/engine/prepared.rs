@@ -1,0 +1,166 @@
+//! A bank made ready for the audio thread: modes sorted by frequency, tables in the units the
+//! voices use, and the level that meets the loudness contract.
+
+use std::f64::consts::{PI, TAU};
+
+use super::controls::Controls;
+use super::position::{PositionMap, PositionWeights};
+use super::stereo::lane_weights;
+use crate::dsp::coeffs::{hz_to_midi_key, ModeCoeffs, MIN_DECAY_PER_S};
+use crate::dsp::{Exciter, Kernel, ResonatorBank, COLUMNS};
+use crate::model::Bank;
+
+/// Peak of a full-velocity mallet strike at the first position, at the bank's defaults: -6 dBFS.
+pub const TARGET_PEAK: f32 = 0.5;
+
+/// Sample rate of the loudness measurement; level does not depend on the rate.
+const MEASURE_RATE_HZ: f64 = 48_000.0;
+
+/// A bank prepared for playing. Built off the audio thread; shared read-only by voices.
+#[derive(Debug, Clone)]
+pub struct PreparedBank {
+    /// The bank as loaded, for display and saving.
+    pub source: Bank,
+    /// Mode frequencies in Hz, ascending.
+    pub freq_hz: Vec<f64>,
+    /// Mode decay rates in 1/s, at least `MIN_DECAY_PER_S`.
+    pub decay_per_s: Vec<f64>,
+    /// `ln(f / f_lowest)` of each mode, for the damping tilt.
+    pub ln_freq_ratio: Vec<f64>,
+    /// Gains, mode-major: `gains[m * num_positions + k]`, scaled by the loudness normalisation.
+    pub gains: Vec<f32>,
+    /// Number of strike positions.
+    pub num_positions: usize,
+    /// The positions, normalised.
+    pub positions: PositionMap,
+    /// MIDI key (fractional) of the bank's root pitch.
+    pub root_key: f64,
+    /// The bank's own quality factor: median of `pi f / d` (with `d` at least
+    /// `MIN_DECAY_PER_S`). Material Q scales decays relative to it.
+    pub reference_q: f64,
+    /// Gain applied to the bank's gains so a default strike peaks at `TARGET_PEAK`.
+    pub normalization: f32,
+}
+
+impl PreparedBank {
+    /// Prepares `bank` (which should have passed validation). Allocates and renders a short
+    /// strike to measure the level.
+    pub fn new(bank: &Bank) -> Self {
+        let k = bank.positions.len().max(1);
+        let mut order: Vec<usize> = (0..bank.modes.len()).collect();
+        order.sort_by(|&a, &b| bank.modes[a].freq_hz.total_cmp(&bank.modes[b].freq_hz));
+        let freq_hz: Vec<f64> = order.iter().map(|&m| bank.modes[m].freq_hz).collect();
+        let lowest = freq_hz.first().copied().unwrap_or(1.0).max(1e-9);
+        let mut gains = Vec::with_capacity(order.len() * k);
+        for &m in &order {
+            let g = &bank.modes[m].gains;
+            gains.extend((0..k).map(|i| g.get(i).copied().unwrap_or(0.0) as f32));
+        }
+        let coords: Vec<Vec<f64>> = bank.positions.iter().map(|p| p.coords.clone()).collect();
+        let decay_per_s: Vec<f64> = order
+            .iter()
+            .map(|&m| bank.modes[m].decay_per_s.max(MIN_DECAY_PER_S))
+            .collect();
+        let mut qs: Vec<f64> = freq_hz
+            .iter()
+            .zip(&decay_per_s)
+            .map(|(f, d)| PI * f / d)
+            .collect();
+        qs.sort_by(f64::total_cmp);
+        let reference_q = qs.get(qs.len() / 2).copied().unwrap_or(1.0);
+        let mut prepared = Self {
+            source: bank.clone(),
+            decay_per_s,
+            ln_freq_ratio: freq_hz.iter().map(|f| (f / lowest).ln()).collect(),
+            freq_hz,
+            gains,
+            num_positions: k,
+            positions: PositionMap::new(&coords),
+            root_key: hz_to_midi_key(bank.effective_root_hz()),
+            reference_q,
+            normalization: 1.0,
+        };
+        let peak = prepared.measure_default_peak();
+        if peak > 0.0 && peak.is_finite() {
+            prepared.normalization = TARGET_PEAK / peak;
+            for g in &mut prepared.gains {
+                *g *= prepared.normalization;
+            }
+        }
+        prepared
+    }
+
+    /// Number of modes.
+    pub fn num_modes(&self) -> usize {
+        self.freq_hz.len()
+    }
+
+    /// Gain of mode `m` for a strike blended by `w`.
+    #[inline]
+    pub fn gain_at(&self, m: usize, w: &PositionWeights) -> f32 {
+        let row = &self.gains[m * self.num_positions..(m + 1) * self.num_positions];
+        (0..w.count).map(|i| w.weight[i] * row[w.index[i]]).sum()
+    }
+
+    /// Natural log of the decay multiplier `Q_ref / Q` for `material_q` (0 when authored).
+    pub fn log_damping(&self, material_q: Option<f32>) -> f64 {
+        material_q.map_or(0.0, |q| (self.reference_q / q as f64).ln())
+    }
+
+    /// Decay rate of mode `m` before pitch scaling, for a decay multiplier `exp(log_damping)`
+    /// and a damping tilt: `d Q_ref / Q (f / f_lowest) ^ tilt`.
+    #[inline]
+    pub fn damped_decay(&self, m: usize, log_damping: f64, damping_tilt: f64) -> f64 {
+        (self.decay_per_s[m] * (log_damping + damping_tilt * self.ln_freq_ratio[m]).exp())
+            .max(MIN_DECAY_PER_S)
+    }
+
+    /// Peak of a full-velocity mallet strike at the first position with the bank's default
+    /// controls at the root pitch, before normalisation.
+    fn measure_default_peak(&self) -> f32 {
+        let controls = Controls::for_bank(&self.source);
+        let n = self.num_modes();
+        let mut bank = ResonatorBank::new(n);
+        let w = PositionWeights::single(0);
+        let theta_max = TAU * crate::dsp::coeffs::MAX_FREQ_RATIO;
+        let log_damping = self.log_damping(controls.material_q);
+        for m in 0..n {
+            let theta = TAU * self.freq_hz[m] / MEASURE_RATE_HZ;
+            if theta < theta_max {
+                let delta = self.damped_decay(m, log_damping, controls.damping_tilt as f64)
+                    / MEASURE_RATE_HZ;
+                bank.activate(
+                    m,
+                    ModeCoeffs::from_angle_radius(theta, delta),
+                    self.gain_at(m, &w),
+                );
+            }
+        }
+        let mut exciter = Exciter::new(1);
+        let contact = (controls.hardness_ms as f64 * 1e-3 * MEASURE_RATE_HZ).round() as u32;
+        exciter.strike(controls.exciter, 1.0, contact);
+        let (wl, wr) = lane_weights(controls.width);
+        // Long enough for the slowest beating of the lowest modes to build up.
+        let lowest = self.freq_hz.first().copied().unwrap_or(100.0).max(1.0);
+        let seconds = (4.0 / lowest).clamp(0.2, 1.0);
+        let total = (seconds * MEASURE_RATE_HZ) as usize;
+        const RUN: usize = 256;
+        let mut acc = vec![[0.0f32; COLUMNS]; RUN];
+        let mut input = vec![0.0f32; RUN];
+        let kernel = Kernel::detect();
+        let mut peak = 0.0f32;
+        for _ in 0..total.div_ceil(RUN) {
+            for a in acc.iter_mut() {
+                *a = [0.0; COLUMNS];
+            }
+            let driven = exciter.render(&mut input);
+            bank.process(kernel, driven.then_some(&input[..]), &mut acc);
+            for a in &acc {
+                let l: f32 = a.iter().zip(&wl).map(|(x, w)| x * w).sum();
+                let r: f32 = a.iter().zip(&wr).map(|(x, w)| x * w).sum();
+                peak = peak.max(l.abs()).max(r.abs());
+            }
+        }
+        peak
+    }
+}

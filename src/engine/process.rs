@@ -1,0 +1,417 @@
+//! The audio-thread half of the engine: events, control ticks and rendering.
+
+use super::*;
+
+impl Engine {
+    /// Renders `out_l.len()` samples into `out_l` and `out_r` (overwritten), applying `events`
+    /// (sorted by time; times past the block act at its last sample) and driving the input voice
+    /// with `input` when given (same length; non-finite samples count as silence).
+    ///
+    /// Never allocates, locks, logs or does I/O.
+    pub fn process(
+        &mut self,
+        events: &[NoteEvent],
+        input: Option<&[f32]>,
+        out_l: &mut [f32],
+        out_r: &mut [f32],
+    ) {
+        assert_eq!(out_l.len(), out_r.len(), "output channels differ in length");
+        if let Some(x) = input {
+            assert_eq!(x.len(), out_l.len(), "input and output lengths differ");
+        }
+        assert!(
+            !self.voices.is_empty(),
+            "Engine::prepare must be called before process"
+        );
+        let _ftz = FlushDenormals::new();
+        let len = out_l.len();
+        let mut next_event = 0;
+        let mut pos = 0;
+        while pos < len {
+            if self.clock % CONTROL_PERIOD as u64 == 0 {
+                self.control_tick();
+            }
+            while next_event < events.len()
+                && (events[next_event].time() as usize).min(len - 1) <= pos
+            {
+                self.apply_event(events[next_event]);
+                next_event += 1;
+            }
+            let to_tick = CONTROL_PERIOD - (self.clock % CONTROL_PERIOD as u64) as usize;
+            let to_event = events
+                .get(next_event)
+                .map_or(len, |e| (e.time() as usize).min(len - 1));
+            let run = to_tick.min(to_event.max(pos + 1) - pos).min(len - pos);
+            self.render_run(
+                input.map(|x| &x[pos..pos + run]),
+                &mut out_l[pos..pos + run],
+                &mut out_r[pos..pos + run],
+            );
+            self.clock += run as u64;
+            pos += run;
+        }
+    }
+
+    /// Natural logs of the decay multiplier and the tilt the controls ask for.
+    pub(super) fn damping_targets(&self) -> (f64, f64) {
+        (
+            self.bank.log_damping(self.controls.material_q),
+            self.controls.damping_tilt as f64,
+        )
+    }
+
+    pub(super) fn rebuild_decay_table(&mut self) {
+        let (log_damping, tilt) = (self.smoothed.log_damping, self.smoothed.tilt);
+        for (m, d) in self.decay.iter_mut().enumerate() {
+            *d = self.bank.damped_decay(m, log_damping, tilt);
+        }
+        self.damping_version += 1;
+    }
+
+    /// One-pole smoothing coefficient per control tick for a time constant.
+    fn tick_coefficient(&self, time_constant_s: f64) -> f64 {
+        1.0 - (-(CONTROL_PERIOD as f64) / (time_constant_s * self.sample_rate_hz)).exp()
+    }
+
+    /// Lowest decay rate of a released voice, in 1/s: release damping 1 gives a 50 ms T60,
+    /// smaller values longer ones (200x longer towards 0), 0 none.
+    fn release_decay(&self) -> f64 {
+        let r = self.controls.release_damping as f64;
+        if r <= 0.0 {
+            0.0
+        } else {
+            t60_to_decay(0.05 * 200f64.powf(1.0 - r))
+        }
+    }
+
+    /// Smoothing steps, truncation, freeing and coefficient updates, every `CONTROL_PERIOD`.
+    fn control_tick(&mut self) {
+        // Material.
+        let (target_damping, target_tilt) = self.damping_targets();
+        let k = self.tick_coefficient(DAMPING_SMOOTHING_S);
+        let s = &mut self.smoothed;
+        if s.log_damping != target_damping || s.tilt != target_tilt {
+            s.log_damping = step_towards(s.log_damping, target_damping, k, 1e-4);
+            s.tilt = step_towards(s.tilt, target_tilt, k, 1e-4);
+            self.rebuild_decay_table();
+        }
+        // Stereo width: ramp the column weights over the next period.
+        let target = lane_weights(self.controls.width);
+        if target != self.smoothed.weights && self.smoothed.weight_ramp_left == 0 {
+            let inv = 1.0 / CONTROL_PERIOD as f32;
+            for j in 0..COLUMNS {
+                self.smoothed.weight_step.0[j] = (target.0[j] - self.smoothed.weights.0[j]) * inv;
+                self.smoothed.weight_step.1[j] = (target.1[j] - self.smoothed.weights.1[j]) * inv;
+            }
+            self.smoothed.weight_ramp_left = CONTROL_PERIOD;
+        }
+
+        let threshold = db_to_gain(self.controls.truncation_db);
+        let pitch_k = self.tick_coefficient(PITCH_SMOOTHING_S);
+        let input_key = self
+            .last_key
+            .unwrap_or(self.bank.root_key.round().clamp(0.0, 127.0) as u8);
+        let input_heard = std::mem::take(&mut self.input_heard);
+        let release = self.release_decay();
+        let version = self.damping_version;
+        let num_voices = self.voices.len();
+        let (controls, bank, decay, rate) =
+            (&self.controls, &self.bank, &self.decay, self.sample_rate_hz);
+        for (i, v) in self
+            .voices
+            .iter_mut()
+            .chain(self.input_voice.as_mut())
+            .enumerate()
+        {
+            let is_input = i == num_voices;
+            if v.state == VoiceState::Free && v.modes.num_live() == 0 {
+                continue;
+            }
+            if v.exciter.is_idle() && !(is_input && input_heard) {
+                v.energy = v.modes.retire_below(threshold);
+                if v.modes.num_live() == 0 {
+                    v.free();
+                    continue;
+                }
+            }
+            let key = if is_input { input_key } else { v.key };
+            v.log_pitch = step_towards(
+                v.log_pitch,
+                target_log_pitch(controls, bank.root_key, key),
+                pitch_k,
+                1e-6,
+            );
+            let tuning = tuning_of(v, version, release);
+            if v.applied != Some(tuning) {
+                v.retune(bank, decay, rate, tuning);
+            }
+        }
+        // Polyphony lowered: fade the quietest voices beyond the limit.
+        while self.voices.iter().filter(|v| v.is_sounding()).count() > self.controls.polyphony {
+            let victim = self.quietest_sounding();
+            self.voices[victim].state = VoiceState::Fading;
+        }
+    }
+
+    fn apply_event(&mut self, event: NoteEvent) {
+        match event {
+            NoteEvent::On { key, velocity, .. } if velocity > 0.0 && velocity.is_finite() => {
+                self.note_on(key, velocity.min(1.0))
+            }
+            NoteEvent::On { key, .. } | NoteEvent::Off { key, .. } => {
+                for i in 0..self.voices.len() {
+                    if self.voices[i].state == VoiceState::Held && self.voices[i].key == key {
+                        self.release(i);
+                    }
+                }
+            }
+            NoteEvent::AllNotesOff { .. } => {
+                for i in 0..self.voices.len() {
+                    if self.voices[i].state == VoiceState::Held {
+                        self.release(i);
+                    }
+                }
+            }
+            NoteEvent::AllSoundOff { .. } => {
+                for v in self.voices.iter_mut().chain(self.input_voice.as_mut()) {
+                    v.free();
+                }
+            }
+        }
+    }
+
+    fn release(&mut self, i: usize) {
+        self.voices[i].state = VoiceState::Released;
+        let tuning = tuning_of(&self.voices[i], self.damping_version, self.release_decay());
+        if self.voices[i].applied != Some(tuning) {
+            self.voices[i].retune(&self.bank, &self.decay, self.sample_rate_hz, tuning);
+        }
+    }
+
+    fn quietest_sounding(&self) -> usize {
+        let loudness = |v: &Voice| {
+            if v.exciter.is_idle() {
+                v.energy
+            } else {
+                f32::INFINITY
+            }
+        };
+        (0..self.voices.len())
+            .filter(|&i| self.voices[i].is_sounding())
+            .min_by(|&a, &b| {
+                let (va, vb) = (&self.voices[a], &self.voices[b]);
+                loudness(va)
+                    .total_cmp(&loudness(vb))
+                    .then(va.age.cmp(&vb.age))
+            })
+            .expect("a sounding voice")
+    }
+
+    /// The voice a note on `key` plays: the one still ringing on that key, a free one, or one
+    /// freed by stealing the quietest.
+    fn voice_for(&mut self, key: u8) -> usize {
+        if let Some(i) = self
+            .voices
+            .iter()
+            .position(|v| v.is_sounding() && v.key == key)
+        {
+            return i;
+        }
+        if self.voices.iter().filter(|v| v.is_sounding()).count() >= self.controls.polyphony {
+            let victim = self.quietest_sounding();
+            self.voices[victim].state = VoiceState::Fading;
+        }
+        if let Some(i) = self.voices.iter().position(|v| v.state == VoiceState::Free) {
+            return i;
+        }
+        // Every slot is fading: reuse the one closest to silence.
+        let i = (0..self.voices.len())
+            .min_by(|&a, &b| {
+                self.voices[a]
+                    .fade_gain
+                    .total_cmp(&self.voices[b].fade_gain)
+            })
+            .expect("voices are allocated");
+        self.voices[i].free();
+        i
+    }
+
+    fn note_on(&mut self, key: u8, velocity: f32) {
+        let i = self.voice_for(key);
+        let fresh = self.voices[i].state == VoiceState::Free;
+        if fresh {
+            self.allocations += 1;
+            let v = &mut self.voices[i];
+            v.key = key;
+            v.age = self.allocations;
+        }
+        self.last_key = Some(key);
+        let target = target_log_pitch(&self.controls, self.bank.root_key, key);
+        let v = &mut self.voices[i];
+        if fresh {
+            v.log_pitch = target;
+        }
+        v.state = VoiceState::Held;
+        let tuning = tuning_of(&self.voices[i], self.damping_version, self.release_decay());
+        if self.voices[i].applied != Some(tuning) {
+            self.voices[i].retune(&self.bank, &self.decay, self.sample_rate_hz, tuning);
+        }
+
+        let c = &self.controls;
+        let vary = c.position_variation;
+        let (x, y) = if vary > 0.0 {
+            (
+                c.strike_x + vary * self.rng.bipolar(),
+                c.strike_y + vary * self.rng.bipolar(),
+            )
+        } else {
+            (c.strike_x, c.strike_y)
+        };
+        let weights = self.bank.positions.weights(x, y);
+        // Force: velocity^(2 s); contact: up to 4x longer for soft notes.
+        let amplitude = velocity.powf(2.0 * c.velocity_sensitivity);
+        let contact_ms = (c.hardness_ms * 4f32.powf(c.velocity_to_hardness * (1.0 - velocity)))
+            .clamp(0.05, 20.0);
+        let len = (contact_ms as f64 * 1e-3 * self.sample_rate_hz)
+            .round()
+            .max(1.0) as u32;
+        let threshold = db_to_gain(c.truncation_db);
+        let kind = c.exciter;
+        self.voices[i].strike(
+            &self.bank,
+            &self.decay,
+            self.sample_rate_hz,
+            tuning,
+            &weights,
+            kind,
+            amplitude,
+            len,
+            threshold,
+        );
+    }
+
+    /// Renders a run of samples within one control period and with no events inside.
+    fn render_run(&mut self, input: Option<&[f32]>, out_l: &mut [f32], out_r: &mut [f32]) {
+        let n = out_l.len();
+        let acc = &mut self.acc[..n];
+        acc.fill([0.0; COLUMNS]);
+        let x = &mut self.excitation[..n];
+        let fade_step = (1.0 / (STEAL_FADE_S * self.sample_rate_hz)) as f32;
+        for v in self.voices.iter_mut() {
+            if v.state == VoiceState::Free && v.modes.num_live() == 0 {
+                continue;
+            }
+            let driven = v.exciter.render(x);
+            let drive = driven.then_some(&x[..]);
+            if v.state == VoiceState::Fading {
+                let fade = &mut self.fade_acc[..n];
+                fade.fill([0.0; COLUMNS]);
+                v.modes.process(self.kernel, drive, fade);
+                for (a, f) in acc.iter_mut().zip(fade.iter()) {
+                    v.fade_gain = (v.fade_gain - fade_step).max(0.0);
+                    for j in 0..COLUMNS {
+                        a[j] += v.fade_gain * f[j];
+                    }
+                }
+                if v.fade_gain <= 0.0 {
+                    v.free();
+                }
+            } else {
+                v.modes.process(self.kernel, drive, acc);
+            }
+        }
+        if let (Some(input), Some(v)) = (input, self.input_voice.as_mut()) {
+            let gain = db_to_gain(self.controls.input_gain_db);
+            let mut heard = false;
+            for (xi, &s) in x.iter_mut().zip(input) {
+                *xi = if s.is_finite() { gain * s } else { 0.0 };
+                heard |= *xi != 0.0;
+            }
+            if heard {
+                self.input_heard = true;
+                if v.modes.num_live() == 0 {
+                    let weights = self
+                        .bank
+                        .positions
+                        .weights(self.controls.strike_x, self.controls.strike_y);
+                    let tuning = tuning_of(v, self.damping_version, 0.0);
+                    v.retune(&self.bank, &self.decay, self.sample_rate_hz, tuning);
+                    // Every mode in range; the strike itself adds nothing (amplitude 0).
+                    v.strike(
+                        &self.bank,
+                        &self.decay,
+                        self.sample_rate_hz,
+                        tuning,
+                        &weights,
+                        crate::dsp::ExciterKind::Impulse,
+                        0.0,
+                        1,
+                        0.0,
+                    );
+                    v.exciter.reset();
+                }
+                v.modes.process(self.kernel, Some(x), acc);
+            } else if v.modes.num_live() > 0 {
+                v.modes.process(self.kernel, None, acc);
+            }
+        } else if let Some(v) = self.input_voice.as_mut().filter(|v| v.modes.num_live() > 0) {
+            v.modes.process(self.kernel, None, acc);
+        }
+
+        let s = &mut self.smoothed;
+        let target_gain = db_to_gain(self.controls.output_gain_db);
+        let gain_k = (1.0 - (-1.0 / (GAIN_SMOOTHING_S * self.sample_rate_hz)).exp()) as f32;
+        for ((a, l), r) in acc.iter().zip(out_l.iter_mut()).zip(out_r.iter_mut()) {
+            if s.weight_ramp_left > 0 {
+                s.weight_ramp_left -= 1;
+                for j in 0..COLUMNS {
+                    s.weights.0[j] += s.weight_step.0[j];
+                    s.weights.1[j] += s.weight_step.1[j];
+                }
+                if s.weight_ramp_left == 0 {
+                    s.weights = lane_weights(self.controls.width);
+                }
+            }
+            s.gain += (target_gain - s.gain) * gain_k;
+            let (mut sl, mut sr) = (0.0, 0.0);
+            for j in 0..COLUMNS {
+                sl += a[j] * s.weights.0[j];
+                sr += a[j] * s.weights.1[j];
+            }
+            *l = sl * s.gain;
+            *r = sr * s.gain;
+        }
+    }
+}
+
+/// One smoothing step from `current` towards `target` by fraction `k`, snapping to the target
+/// once within `snap`.
+fn step_towards(current: f64, target: f64, k: f64, snap: f64) -> f64 {
+    let next = current + (target - current) * k;
+    if (target - next).abs() <= snap || !next.is_finite() {
+        target
+    } else {
+        next
+    }
+}
+
+/// The pitch (natural log of the frequency ratio) a voice on `key` is heading for.
+fn target_log_pitch(c: &Controls, root_key: f64, key: u8) -> f64 {
+    let semitones = c.key_tracking as f64 * (key as f64 - root_key)
+        + c.fine_tune_cents as f64 / 100.0
+        + c.pitch_bend_semitones as f64;
+    semitones * std::f64::consts::LN_2 / 12.0 - (c.size_ratio as f64).ln()
+}
+
+/// The tuning voice `v` should have, given the engine's decay table version and the release decay.
+fn tuning_of(v: &Voice, damping_version: u64, release_decay_per_s: f64) -> Tuning {
+    Tuning {
+        log_pitch: v.log_pitch,
+        damping_version,
+        release_decay_per_s: if v.state == VoiceState::Released {
+            release_decay_per_s
+        } else {
+            0.0
+        },
+    }
+}

@@ -1,0 +1,170 @@
+//! One sounding object: its resonators, the strikes under way, and its pitch.
+
+use std::f64::consts::TAU;
+
+use super::position::PositionWeights;
+use super::prepared::PreparedBank;
+use crate::dsp::coeffs::{t60_to_decay, ModeCoeffs, MAX_FREQ_RATIO};
+use crate::dsp::{Exciter, ExciterKind, ResonatorBank};
+
+/// Pole angle (radians per sample) above which a mode is not started, and at which a sounding
+/// mode pushed higher is held while it fades out.
+const THETA_MAX: f64 = TAU * MAX_FREQ_RATIO;
+
+/// T60 in seconds of a mode pushed above `THETA_MAX` by a pitch change: gone before it is heard
+/// aliasing, without a click.
+const ABOVE_RANGE_T60_S: f64 = 0.005;
+
+/// What a voice is doing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VoiceState {
+    /// Silent and available.
+    Free,
+    /// Struck, key still down.
+    Held,
+    /// Struck, key released: rings on (or damps, with release damping).
+    Released,
+    /// Stolen: fading out over a few milliseconds before it is freed.
+    Fading,
+}
+
+/// The parameters a voice's coefficients were last computed with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tuning {
+    /// Natural log of the pitch ratio.
+    pub log_pitch: f64,
+    /// Version of the engine's decay table.
+    pub damping_version: u64,
+    /// Lowest decay rate imposed by release damping, in 1/s (0 = none).
+    pub release_decay_per_s: f64,
+}
+
+/// One voice.
+#[derive(Debug, Clone)]
+pub struct Voice {
+    /// What the voice is doing.
+    pub state: VoiceState,
+    /// MIDI key that struck it.
+    pub key: u8,
+    /// Order of allocation, to break ties when stealing.
+    pub age: u64,
+    /// The resonators.
+    pub modes: ResonatorBank,
+    /// Strikes under way.
+    pub exciter: Exciter,
+    /// Natural log of the current (smoothed) pitch ratio.
+    pub log_pitch: f64,
+    /// The tuning the coefficients hold, or `None` when they must be recomputed.
+    pub applied: Option<Tuning>,
+    /// Summed squared amplitude of the modes at the last control tick.
+    pub energy: f32,
+    /// Gain while fading after being stolen, 1 down to 0.
+    pub fade_gain: f32,
+}
+
+impl Voice {
+    /// A free voice for banks of up to `num_modes` modes. Allocates.
+    pub fn new(num_modes: usize, seed: u32) -> Self {
+        Self {
+            state: VoiceState::Free,
+            key: 0,
+            age: 0,
+            modes: ResonatorBank::new(num_modes),
+            exciter: Exciter::new(seed),
+            log_pitch: 0.0,
+            applied: None,
+            energy: 0.0,
+            fade_gain: 1.0,
+        }
+    }
+
+    /// Whether the voice counts against polyphony.
+    pub fn is_sounding(&self) -> bool {
+        matches!(self.state, VoiceState::Held | VoiceState::Released)
+    }
+
+    /// Silences the voice and makes it available.
+    pub fn free(&mut self) {
+        self.state = VoiceState::Free;
+        self.modes.clear();
+        self.exciter.reset();
+        self.applied = None;
+        self.energy = 0.0;
+        self.fade_gain = 1.0;
+    }
+
+    /// Coefficients of mode `m` at `tuning`, given the decay table and the sample rate.
+    #[inline]
+    fn coeffs(
+        bank: &PreparedBank,
+        decay: &[f64],
+        sample_rate_hz: f64,
+        pitch: f64,
+        release: f64,
+        m: usize,
+    ) -> ModeCoeffs {
+        let theta = TAU * bank.freq_hz[m] * pitch / sample_rate_hz;
+        let decay_per_s = (decay[m] * pitch).max(release);
+        if theta >= THETA_MAX {
+            let fade = t60_to_decay(ABOVE_RANGE_T60_S).max(decay_per_s);
+            ModeCoeffs::from_angle_radius(THETA_MAX, fade / sample_rate_hz)
+        } else {
+            ModeCoeffs::from_angle_radius(theta, decay_per_s / sample_rate_hz)
+        }
+    }
+
+    /// Recomputes the coefficients of every live mode for `tuning`.
+    pub fn retune(
+        &mut self,
+        bank: &PreparedBank,
+        decay: &[f64],
+        sample_rate_hz: f64,
+        tuning: Tuning,
+    ) {
+        let pitch = tuning.log_pitch.exp();
+        let release = tuning.release_decay_per_s;
+        self.modes
+            .set_coeffs_with(|m| Self::coeffs(bank, decay, sample_rate_hz, pitch, release, m));
+        self.applied = Some(tuning);
+    }
+
+    /// Strikes the voice: restarts modes that have died (unless the strike cannot lift them above
+    /// `threshold`), sets every mode's gain for the strike point `weights`, and starts the pulse.
+    /// The voice's coefficients must be current (`applied == Some(tuning)`).
+    #[allow(clippy::too_many_arguments)] // one call site; the values are all distinct and plain
+    pub fn strike(
+        &mut self,
+        bank: &PreparedBank,
+        decay: &[f64],
+        sample_rate_hz: f64,
+        tuning: Tuning,
+        weights: &PositionWeights,
+        kind: ExciterKind,
+        amplitude: f32,
+        len_samples: u32,
+        threshold: f32,
+    ) {
+        let pitch = tuning.log_pitch.exp();
+        let bound = amplitude * kind.peak_bound(len_samples);
+        for m in 0..bank.num_modes() {
+            if self.modes.is_live(m) {
+                continue;
+            }
+            let gain = bank.gain_at(m, weights);
+            let theta = TAU * bank.freq_hz[m] * pitch / sample_rate_hz;
+            if theta < THETA_MAX && gain.abs() * bound >= threshold {
+                let c = Self::coeffs(
+                    bank,
+                    decay,
+                    sample_rate_hz,
+                    pitch,
+                    tuning.release_decay_per_s,
+                    m,
+                );
+                self.modes.activate(m, c, gain);
+            }
+        }
+        self.modes.set_gains_with(|m| bank.gain_at(m, weights));
+        self.exciter.strike(kind, amplitude, len_samples);
+    }
+}

@@ -1,0 +1,120 @@
+//! Helpers shared by the integration tests: banks built in code and small signal measurements.
+#![allow(dead_code)]
+
+use std::sync::Arc;
+
+use modal_resonator::engine::{Engine, NoteEvent, PreparedBank};
+use modal_resonator::model::{Bank, Mode, Position};
+
+/// A 1-D bank of `modes` given as `(freq_hz, decay_per_s, gain)`, with a single position.
+pub fn simple_bank(modes: &[(f64, f64, f64)]) -> Bank {
+    let mut bank = Bank::new("test", vec![Position { name: "a".into(), coords: vec![0.0] }]);
+    bank.modes = modes
+        .iter()
+        .map(|&(f, d, g)| Mode { freq_hz: f, decay_per_s: d, gains: vec![g] })
+        .collect();
+    bank
+}
+
+/// A bank of `n` inharmonic modes from `f0` with two positions, deterministic.
+pub fn dense_bank(n: usize, f0: f64) -> Bank {
+    let positions = vec![
+        Position { name: "end".into(), coords: vec![0.0] },
+        Position { name: "middle".into(), coords: vec![0.5] },
+    ];
+    let mut bank = Bank::new("dense", positions);
+    let mut seed = 12345u32;
+    let mut rnd = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 17;
+        seed ^= seed << 5;
+        seed as f64 / u32::MAX as f64
+    };
+    bank.modes = (0..n)
+        .map(|i| {
+            let f = f0 * (1.0 + i as f64 * (0.7 + 0.6 * rnd()));
+            Mode {
+                freq_hz: f,
+                decay_per_s: 1.0 + f / 400.0,
+                gains: vec![(1.0 / (1.0 + i as f64 * 0.1)) * (rnd() - 0.3), 0.5 * (rnd() - 0.5)],
+            }
+        })
+        .collect();
+    bank.root_hz = Some(f0);
+    bank
+}
+
+/// An engine playing `bank`, prepared at `rate`.
+pub fn engine(bank: &Bank, rate: f32) -> Engine {
+    let mut e = Engine::new(Arc::new(PreparedBank::new(bank)));
+    e.prepare(rate, 512);
+    e
+}
+
+/// Renders `seconds` of stereo from `engine` in blocks of `block`, with `events` given in absolute
+/// sample times.
+pub fn render(engine: &mut Engine, events: &[NoteEvent], seconds: f64, block: usize) -> (Vec<f32>, Vec<f32>) {
+    let total = (seconds * engine.sample_rate_hz() as f64) as usize;
+    let mut l = vec![0.0; total];
+    let mut r = vec![0.0; total];
+    let mut start = 0;
+    let mut block_events = Vec::new();
+    while start < total {
+        let end = (start + block).min(total);
+        block_events.clear();
+        for e in events {
+            let t = e.time() as usize;
+            if t >= start && t < end {
+                block_events.push(shift(*e, start as u32));
+            }
+        }
+        engine.process(&block_events, None, &mut l[start..end], &mut r[start..end]);
+        start = end;
+    }
+    (l, r)
+}
+
+/// `event` with its time made relative to `offset`.
+pub fn shift(event: NoteEvent, offset: u32) -> NoteEvent {
+    match event {
+        NoteEvent::On { time, key, velocity } => NoteEvent::On { time: time - offset, key, velocity },
+        NoteEvent::Off { time, key } => NoteEvent::Off { time: time - offset, key },
+        NoteEvent::AllNotesOff { time } => NoteEvent::AllNotesOff { time: time - offset },
+        NoteEvent::AllSoundOff { time } => NoteEvent::AllSoundOff { time: time - offset },
+    }
+}
+
+/// A note-on at absolute sample `time`.
+pub fn on(time: u32, key: u8, velocity: f32) -> NoteEvent {
+    NoteEvent::On { time, key, velocity }
+}
+
+/// Largest absolute sample.
+pub fn peak(x: &[f32]) -> f32 {
+    x.iter().fold(0.0, |a, v| a.max(v.abs()))
+}
+
+/// Largest absolute difference between consecutive samples in `x`.
+pub fn max_step(x: &[f32]) -> f32 {
+    x.windows(2).fold(0.0, |a, w| a.max((w[1] - w[0]).abs()))
+}
+
+/// Fundamental frequency of `x` by autocorrelation peak picking with parabolic refinement,
+/// searching `lo_hz..hi_hz`.
+pub fn pitch_hz(x: &[f32], rate: f64, lo_hz: f64, hi_hz: f64) -> f64 {
+    let n = x.len().min((rate * 0.5) as usize);
+    let x = &x[..n];
+    let ac = |lag: usize| -> f64 { x[..n - lag].iter().zip(&x[lag..]).map(|(a, b)| (*a as f64) * (*b as f64)).sum() };
+    let (min_lag, max_lag) = ((rate / hi_hz) as usize, (rate / lo_hz) as usize);
+    let mut best = (min_lag, f64::MIN);
+    for lag in min_lag..=max_lag.min(n / 2) {
+        let v = ac(lag);
+        if v > best.1 {
+            best = (lag, v);
+        }
+    }
+    let l = best.0;
+    let (a, b, c) = (ac(l - 1), ac(l), ac(l + 1));
+    let shift = 0.5 * (a - c) / (a - 2.0 * b + c);
+    rate / (l as f64 + shift)
+}
