@@ -1,10 +1,13 @@
 //! A bank of modal resonators for one voice: structure-of-arrays state, coefficients and gains,
 //! with the live modes packed so work follows the number of modes still sounding.
 //!
-//! Mode `m` always lives in column `m % COLUMNS`, so it keeps its accumulator lane (and with it
-//! its place in the stereo field) however the bank is re-packed. Within a column, live modes occupy
-//! the first rows; a mode that dies is replaced by the column's last live mode. The kernels run
-//! over as many rows as the fullest column needs.
+//! A mode keeps its column (its accumulator lane, and with it its place in the stereo field) for
+//! as long as it sounds, however the bank is re-packed. Within a column, live modes occupy the
+//! first rows; a mode that dies is replaced by the column's last live mode. The kernels run over
+//! as many rows as the fullest column needs, so a mode starting from rest goes to its own column
+//! `m % COLUMNS` when that column is among the emptiest, else to the next emptiest one: modes
+//! sorted by frequency are dealt round the columns, and a bank where every other mode is silent
+//! (a string struck at its middle) still fills every lane.
 
 use super::coeffs::ModeCoeffs;
 pub use super::kernels::COLUMNS;
@@ -86,7 +89,11 @@ impl ResonatorBank {
         if self.is_live(mode) {
             return false;
         }
-        let column = mode % COLUMNS;
+        let fewest = self.live.iter().copied().min().unwrap_or(0);
+        let column = (0..COLUMNS)
+            .map(|i| (mode + i) % COLUMNS)
+            .find(|&c| self.live[c] == fewest)
+            .unwrap_or(mode % COLUMNS);
         let slot = self.live[column] as usize * COLUMNS + column;
         self.live[column] += 1;
         self.re[slot] = 0.0;
@@ -263,5 +270,16 @@ mod tests {
             }
         }
         assert_eq!(kept.num_live(), 100 - 34);
+    }
+
+    #[test]
+    fn skipped_modes_do_not_leave_lanes_empty() {
+        // Only even modes sound, as when a string is struck at its middle.
+        let mut bank = ResonatorBank::new(256);
+        for m in (0..256).step_by(2) {
+            bank.activate(m, coeffs(m), 1.0);
+        }
+        assert_eq!(bank.live, [16; COLUMNS]);
+        assert_eq!(bank.num_computed(), 128);
     }
 }
