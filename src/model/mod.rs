@@ -3,5 +3,7 @@
 //! Nothing here runs on the audio thread: code in this module may allocate and may fail.
 
 pub mod bank;
+pub mod validate;
 
 pub use bank::{Bank, BankDefaults, Mode, Position};
+pub use validate::Problem;
