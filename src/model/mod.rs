@@ -4,6 +4,7 @@
 
 pub mod bank;
 pub mod io;
+pub mod schema;
 pub mod validate;
 
 pub use bank::{Bank, BankDefaults, Mode, Position};
