@@ -3,5 +3,10 @@
 //! Nothing here runs on the audio thread: code in this module may allocate and may fail.
 
 pub mod bank;
+pub mod io;
+pub mod schema;
+pub mod validate;
 
 pub use bank::{Bank, BankDefaults, Mode, Position};
+pub use io::{load_bank_file, parse_bank_str, save_bank_file, BankError, BankErrorKind};
+pub use validate::Problem;
