@@ -8,10 +8,20 @@ use modal_resonator::model::{Bank, Mode, Position};
 
 /// A 1-D bank of `modes` given as `(freq_hz, decay_per_s, gain)`, with a single position.
 pub fn simple_bank(modes: &[(f64, f64, f64)]) -> Bank {
-    let mut bank = Bank::new("test", vec![Position { name: "a".into(), coords: vec![0.0] }]);
+    let mut bank = Bank::new(
+        "test",
+        vec![Position {
+            name: "a".into(),
+            coords: vec![0.0],
+        }],
+    );
     bank.modes = modes
         .iter()
-        .map(|&(f, d, g)| Mode { freq_hz: f, decay_per_s: d, gains: vec![g] })
+        .map(|&(f, d, g)| Mode {
+            freq_hz: f,
+            decay_per_s: d,
+            gains: vec![g],
+        })
         .collect();
     bank
 }
@@ -19,8 +29,14 @@ pub fn simple_bank(modes: &[(f64, f64, f64)]) -> Bank {
 /// A bank of `n` inharmonic modes from `f0` with two positions, deterministic.
 pub fn dense_bank(n: usize, f0: f64) -> Bank {
     let positions = vec![
-        Position { name: "end".into(), coords: vec![0.0] },
-        Position { name: "middle".into(), coords: vec![0.5] },
+        Position {
+            name: "end".into(),
+            coords: vec![0.0],
+        },
+        Position {
+            name: "middle".into(),
+            coords: vec![0.5],
+        },
     ];
     let mut bank = Bank::new("dense", positions);
     let mut seed = 12345u32;
@@ -36,7 +52,10 @@ pub fn dense_bank(n: usize, f0: f64) -> Bank {
             Mode {
                 freq_hz: f,
                 decay_per_s: 1.0 + f / 400.0,
-                gains: vec![(1.0 / (1.0 + i as f64 * 0.1)) * (rnd() - 0.3), 0.5 * (rnd() - 0.5)],
+                gains: vec![
+                    (1.0 / (1.0 + i as f64 * 0.1)) * (rnd() - 0.3),
+                    0.5 * (rnd() - 0.5),
+                ],
             }
         })
         .collect();
@@ -53,7 +72,12 @@ pub fn engine(bank: &Bank, rate: f32) -> Engine {
 
 /// Renders `seconds` of stereo from `engine` in blocks of `block`, with `events` given in absolute
 /// sample times.
-pub fn render(engine: &mut Engine, events: &[NoteEvent], seconds: f64, block: usize) -> (Vec<f32>, Vec<f32>) {
+pub fn render(
+    engine: &mut Engine,
+    events: &[NoteEvent],
+    seconds: f64,
+    block: usize,
+) -> (Vec<f32>, Vec<f32>) {
     let total = (seconds * engine.sample_rate_hz() as f64) as usize;
     let mut l = vec![0.0; total];
     let mut r = vec![0.0; total];
@@ -77,16 +101,35 @@ pub fn render(engine: &mut Engine, events: &[NoteEvent], seconds: f64, block: us
 /// `event` with its time made relative to `offset`.
 pub fn shift(event: NoteEvent, offset: u32) -> NoteEvent {
     match event {
-        NoteEvent::On { time, key, velocity } => NoteEvent::On { time: time - offset, key, velocity },
-        NoteEvent::Off { time, key } => NoteEvent::Off { time: time - offset, key },
-        NoteEvent::AllNotesOff { time } => NoteEvent::AllNotesOff { time: time - offset },
-        NoteEvent::AllSoundOff { time } => NoteEvent::AllSoundOff { time: time - offset },
+        NoteEvent::On {
+            time,
+            key,
+            velocity,
+        } => NoteEvent::On {
+            time: time - offset,
+            key,
+            velocity,
+        },
+        NoteEvent::Off { time, key } => NoteEvent::Off {
+            time: time - offset,
+            key,
+        },
+        NoteEvent::AllNotesOff { time } => NoteEvent::AllNotesOff {
+            time: time - offset,
+        },
+        NoteEvent::AllSoundOff { time } => NoteEvent::AllSoundOff {
+            time: time - offset,
+        },
     }
 }
 
 /// A note-on at absolute sample `time`.
 pub fn on(time: u32, key: u8, velocity: f32) -> NoteEvent {
-    NoteEvent::On { time, key, velocity }
+    NoteEvent::On {
+        time,
+        key,
+        velocity,
+    }
 }
 
 /// Largest absolute sample.
@@ -104,7 +147,13 @@ pub fn max_step(x: &[f32]) -> f32 {
 pub fn pitch_hz(x: &[f32], rate: f64, lo_hz: f64, hi_hz: f64) -> f64 {
     let n = x.len().min((rate * 0.5) as usize);
     let x = &x[..n];
-    let ac = |lag: usize| -> f64 { x[..n - lag].iter().zip(&x[lag..]).map(|(a, b)| (*a as f64) * (*b as f64)).sum() };
+    let ac = |lag: usize| -> f64 {
+        x[..n - lag]
+            .iter()
+            .zip(&x[lag..])
+            .map(|(a, b)| (*a as f64) * (*b as f64))
+            .sum()
+    };
     let (min_lag, max_lag) = ((rate / hi_hz) as usize, (rate / lo_hz) as usize);
     let mut best = (min_lag, f64::MIN);
     for lag in min_lag..=max_lag.min(n / 2) {

@@ -1,0 +1,456 @@
+//! Engine behaviour: timing, polyphony, truncation, loudness, smoothness and robustness.
+
+mod common;
+
+use common::*;
+use modal_resonator::dsp::coeffs::{db_to_gain, gain_to_db, midi_key_to_hz, t60_to_decay};
+use modal_resonator::engine::{Controls, NoteEvent, CONTROL_PERIOD, TARGET_PEAK};
+
+const RATE: f32 = 48_000.0;
+
+#[test]
+fn block_size_does_not_change_the_output() {
+    let bank = dense_bank(300, 110.0);
+    let events = [
+        on(5, 45, 1.0),
+        on(1003, 52, 0.6),
+        NoteEvent::Off {
+            time: 3000,
+            key: 45,
+        },
+        on(7777, 45, 0.3),
+    ];
+    let reference = render(&mut engine(&bank, RATE), &events, 0.5, 4096);
+    for block in [1, 17, 64, 333] {
+        let got = render(&mut engine(&bank, RATE), &events, 0.5, block);
+        assert!(got == reference, "block {block} differs from block 4096");
+    }
+}
+
+#[test]
+fn reset_reproduces_the_output_exactly() {
+    let bank = dense_bank(200, 220.0);
+    let mut controls = Controls::default();
+    controls.position_variation = 0.3;
+    controls.exciter = modal_resonator::dsp::ExciterKind::Noise;
+    let mut e = engine(&bank, RATE);
+    e.set_controls(&controls);
+    let events = [on(0, 57, 0.9), on(2400, 60, 0.7)];
+    let first = render(&mut e, &events, 0.3, 256);
+    e.reset();
+    let second = render(&mut e, &events, 0.3, 256);
+    assert!(first == second, "output after reset differs");
+    assert!(peak(&first.0) > 0.01);
+}
+
+#[test]
+fn notes_start_on_their_exact_sample() {
+    let bank = simple_bank(&[(440.0, 3.0, 1.0)]);
+    for block in [1, 64, 1000] {
+        for &t in &[0u32, 1, 63, 64, 999, 1234] {
+            let (l, _) = render(&mut engine(&bank, RATE), &[on(t, 69, 1.0)], 0.05, block);
+            let first = l.iter().position(|&v| v != 0.0).unwrap();
+            // The mode starts at zero phase: silent on the strike sample, sounding from the next.
+            assert_eq!(first, t as usize + 1, "block {block}, note at {t}");
+        }
+    }
+}
+
+#[test]
+fn a_strike_peaks_near_minus_6_dbfs_at_every_rate() {
+    for bank in [
+        simple_bank(&[(440.0, 2.0, 1.0)]),
+        simple_bank(&[(220.0, 2.0, 0.001), (661.0, 5.0, 0.002)]),
+        dense_bank(1000, 110.0),
+        dense_bank(12, 1000.0),
+    ] {
+        let root_key =
+            modal_resonator::dsp::coeffs::hz_to_midi_key(bank.effective_root_hz()).round() as u8;
+        let mut peaks = Vec::new();
+        for rate in [44_100.0, 48_000.0, 96_000.0, 192_000.0] {
+            let mut e = engine(&bank, rate);
+            let (l, r) = render(&mut e, &[on(0, root_key, 1.0)], 0.5, 512);
+            peaks.push(gain_to_db(peak(&l).max(peak(&r))));
+        }
+        let (lo, hi) = peaks
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        assert!(
+            hi - lo <= 0.5,
+            "{} modes: peaks {peaks:?} dBFS differ by more than 0.5 dB",
+            bank.modes.len()
+        );
+        assert!(
+            (peaks[1] - gain_to_db(TARGET_PEAK)).abs() <= 1.0,
+            "{} modes: peak {} dBFS at 48 kHz, expected about -6",
+            bank.modes.len(),
+            peaks[1]
+        );
+    }
+}
+
+#[test]
+fn truncation_ends_modes_at_the_threshold_and_frees_the_voice() {
+    let decay = t60_to_decay(0.5);
+    let bank = simple_bank(&[(440.0, decay as f64, 1.0)]);
+    for truncation_db in [-60.0f32, -96.0, -120.0] {
+        let mut e = engine(&bank, RATE);
+        let mut c = e.controls().clone();
+        c.truncation_db = truncation_db;
+        c.width = 0.0;
+        c.exciter = modal_resonator::dsp::ExciterKind::Impulse;
+        e.set_controls(&c);
+        // An impulse leaves the mode at its (normalised) gain.
+        let amplitude = e.bank().gains[0] as f64;
+        let (l, _) = render(&mut e, &[on(0, 69, 1.0)], 2.0, 512);
+        assert!(e.is_silent(), "voice not freed at {truncation_db} dB");
+        assert_eq!(e.stats().voices, 0);
+        let last = l.iter().rposition(|&v| v != 0.0).unwrap();
+        // Analytic cut-off (seed 000 eq. 5.14): amplitude a exp(-d t) reaches the threshold at
+        // t = ln(a / tau) / d; the engine checks once per control period.
+        let tau = db_to_gain(truncation_db) as f64;
+        let cut = ((amplitude / tau).ln() / decay * RATE as f64) as usize;
+        assert!(
+            last + 1 >= cut && last <= cut + CONTROL_PERIOD + 1,
+            "{truncation_db} dB: output ends at sample {last}, analytic cut-off {cut}"
+        );
+        // What was dropped is below the threshold.
+        let mut reference = engine(&bank, RATE);
+        let mut c2 = c.clone();
+        c2.truncation_db = -140.0;
+        reference.set_controls(&c2);
+        let (full, _) = render(&mut reference, &[on(0, 69, 1.0)], 2.0, 512);
+        let dropped = peak(&full[last + 1..]);
+        assert!(
+            dropped <= tau as f32,
+            "{truncation_db} dB: dropped tail peaks at {dropped}, threshold {tau}"
+        );
+    }
+}
+
+#[test]
+fn restriking_a_ringing_key_adds_without_a_click() {
+    let bank = dense_bank(50, 220.0);
+    let mut e = engine(&bank, RATE);
+    let t2 = 12_000;
+    let (l, _) = render(&mut e, &[on(0, 57, 1.0), on(t2, 57, 1.0)], 0.6, 256);
+    assert_eq!(e.stats().voices, 1, "the same key re-uses its voice");
+    let before = max_step(&l[..t2 as usize]);
+    let around = max_step(&l[t2 as usize - 10..t2 as usize + 10]);
+    assert!(
+        around <= before,
+        "re-strike step {around} exceeds the first strike's largest step {before}"
+    );
+    // The new strike adds to the old: the level just after it differs from a lone strike's.
+    let (lone, _) = render(&mut engine(&bank, RATE), &[on(0, 57, 1.0)], 0.1, 256);
+    let after = &l[t2 as usize..t2 as usize + 2_000];
+    assert!(
+        after
+            .iter()
+            .zip(&lone[..2_000])
+            .any(|(a, b)| (a - b).abs() > 1e-3),
+        "re-strike reset the voice"
+    );
+}
+
+#[test]
+fn voices_are_stolen_quietest_first_with_a_fade() {
+    let bank = dense_bank(40, 220.0);
+    let mut e = engine(&bank, RATE);
+    let mut c = e.controls().clone();
+    c.polyphony = 2;
+    e.set_controls(&c);
+    // The first note is soft, the second loud: the third steals the first.
+    let events = [on(0, 50, 0.2), on(2_000, 55, 1.0), on(4_000, 60, 1.0)];
+    let (l, _) = render(&mut e, &events, 0.2, 128);
+    assert_eq!(e.stats().voices, 2);
+    let steady = max_step(&l[2_100..3_900]);
+    let steal = max_step(&l[3_990..4_400]);
+    assert!(
+        steal <= steady * 1.5,
+        "steal step {steal} vs steady {steady}"
+    );
+}
+
+/// Renders `bank` struck at t = 0, changing controls to `to` at 0.1 s; returns the output and
+/// the same render with `to` from the start.
+fn sweep(bank: &modal_resonator::model::Bank, to: &Controls) -> (Vec<f32>, Vec<f32>) {
+    let mut e = engine(bank, RATE);
+    let mut l = vec![0.0; 24_000];
+    let mut r = vec![0.0; 24_000];
+    let switch = 4_800;
+    e.process(&[on(0, 57, 1.0)], None, &mut l[..switch], &mut r[..switch]);
+    e.set_controls(to);
+    e.process(&[], None, &mut l[switch..], &mut r[switch..]);
+    let mut steady = engine(bank, RATE);
+    steady.set_controls(to);
+    let (sl, _) = render(&mut steady, &[on(0, 57, 1.0)], 0.5, 512);
+    (l, sl)
+}
+
+#[test]
+fn parameter_changes_while_ringing_do_not_click() {
+    let bank = dense_bank(60, 220.0);
+    let base = Controls::for_bank(&bank);
+    let mut bend = base.clone();
+    bend.pitch_bend_semitones = 2.0;
+    let mut size = base.clone();
+    size.size_ratio = 0.5;
+    let mut q = base.clone();
+    q.material_q = Some(30.0);
+    let mut tilt = base.clone();
+    tilt.damping_tilt = 1.5;
+    let mut gain = base.clone();
+    gain.output_gain_db = -30.0;
+    let mut width = base.clone();
+    width.width = 1.0;
+    for (name, to) in [
+        ("bend", bend),
+        ("size", size),
+        ("q", q),
+        ("tilt", tilt),
+        ("gain", gain),
+        ("width", width),
+    ] {
+        let (l, steady) = sweep(&bank, &to);
+        // The signal's own largest step: before the change, or at the new setting.
+        let own = max_step(&l[100..4_800]).max(max_step(&steady[100..]));
+        let during = max_step(&l[4_790..6_000]);
+        assert!(
+            during <= own,
+            "{name}: step {during} during the change exceeds the signal's own {own}"
+        );
+    }
+    // A 2-semitone bend in 10 ms lands on the new pitch.
+    let (l, _) = sweep(&simple_bank(&[(220.0, 1.0, 1.0)]), &{
+        let mut c = Controls::default();
+        c.pitch_bend_semitones = 2.0;
+        c
+    });
+    let got = pitch_hz(&l[4_800 + 480..], RATE as f64, 150.0, 400.0);
+    let want = 220.0 * 2f64.powf(2.0 / 12.0);
+    assert!(
+        (got / want - 1.0).abs() < 0.002,
+        "after the bend: {got} Hz, want {want}"
+    );
+}
+
+#[test]
+fn key_tracking_size_and_tuning_set_the_pitch() {
+    let bank = simple_bank(&[(220.0, 1.0, 1.0)]);
+    let cases: [(u8, f32, f32, f32, f64); 5] = [
+        (57, 1.0, 1.0, 0.0, 220.0),
+        (69, 1.0, 1.0, 0.0, 440.0),
+        (69, 0.0, 1.0, 0.0, 220.0),
+        (57, 1.0, 2.0, 0.0, 110.0),
+        (57, 1.0, 1.0, 50.0, 220.0 * 2f64.powf(0.5 / 12.0)),
+    ];
+    for (key, tracking, size, cents, want) in cases {
+        let mut e = engine(&bank, RATE);
+        let mut c = e.controls().clone();
+        c.key_tracking = tracking;
+        c.size_ratio = size;
+        c.fine_tune_cents = cents;
+        e.set_controls(&c);
+        let (l, _) = render(&mut e, &[on(0, key, 1.0)], 0.4, 512);
+        let got = pitch_hz(&l[100..], RATE as f64, 60.0, 900.0);
+        assert!(
+            (got / want - 1.0).abs() < 0.001,
+            "key {key}, tracking {tracking}, size {size}: {got} Hz, want {want}"
+        );
+    }
+    assert!((midi_key_to_hz(57.0) - 220.0).abs() < 1e-9);
+}
+
+#[test]
+fn modes_above_the_limit_are_not_played() {
+    // 30 kHz is above 0.45 fs at 48 kHz but fine at 96 kHz.
+    let bank = simple_bank(&[(1_000.0, 5.0, 1.0), (30_000.0, 5.0, 1.0)]);
+    let mut e = engine(&bank, 48_000.0);
+    render(&mut e, &[on(0, 83, 1.0)], 0.01, 64);
+    assert_eq!(e.stats().live_modes, 1);
+    let mut e = engine(&bank, 96_000.0);
+    let mut c = e.controls().clone();
+    c.key_tracking = 0.0;
+    e.set_controls(&c);
+    render(&mut e, &[on(0, 83, 1.0)], 0.01, 64);
+    assert_eq!(e.stats().live_modes, 2);
+}
+
+#[test]
+fn strike_position_selects_the_gain_column() {
+    // Mode 1 is silent at the first position, mode 2 at the second.
+    let mut bank = simple_bank(&[(300.0, 2.0, 1.0), (1_700.0, 2.0, 0.0)]);
+    bank.positions.push(modal_resonator::model::Position {
+        name: "b".into(),
+        coords: vec![1.0],
+    });
+    bank.modes[0].gains.push(0.0);
+    bank.modes[1].gains.push(1.0);
+    for (x, want_live) in [(0.0f32, 1usize), (1.0, 1), (0.5, 2)] {
+        let mut e = engine(&bank, RATE);
+        let mut c = e.controls().clone();
+        c.strike_x = x;
+        e.set_controls(&c);
+        render(&mut e, &[on(0, 60, 1.0)], 0.05, 64);
+        assert_eq!(e.stats().live_modes, want_live, "strike at {x}");
+    }
+}
+
+#[test]
+fn velocity_sets_force_and_hardness() {
+    let bank = dense_bank(200, 100.0);
+    let level = |velocity: f32| {
+        let (l, _) = render(&mut engine(&bank, RATE), &[on(0, 43, velocity)], 0.2, 256);
+        l
+    };
+    let (soft, loud) = (level(0.3), level(1.0));
+    assert!(
+        peak(&soft) < 0.5 * peak(&loud),
+        "soft {} vs loud {}",
+        peak(&soft),
+        peak(&loud)
+    );
+    // Brightness: share of energy in sample-to-sample differences (a high-pass).
+    let brightness = |x: &[f32]| {
+        let e: f32 = x.iter().map(|v| v * v).sum();
+        let d: f32 = x.windows(2).map(|w| (w[1] - w[0]).powi(2)).sum();
+        d / e
+    };
+    assert!(
+        brightness(&loud) > brightness(&soft),
+        "a harder strike must be brighter"
+    );
+}
+
+#[test]
+fn extreme_values_and_bad_input_never_break_the_sound() {
+    let bank = dense_bank(500, 30.0);
+    let mut e = engine(&bank, 44_100.0);
+    let mut rng = 1u32;
+    let mut next = || {
+        rng ^= rng << 13;
+        rng ^= rng >> 17;
+        rng ^= rng << 5;
+        rng as f32 / u32::MAX as f32
+    };
+    let specials = [
+        f32::NAN,
+        f32::INFINITY,
+        -f32::INFINITY,
+        0.0,
+        -1e30,
+        1e30,
+        f32::MIN_POSITIVE,
+    ];
+    let mut input = vec![0.0f32; 256];
+    let (mut l, mut r) = (vec![0.0; 256], vec![0.0; 256]);
+    for block in 0..400 {
+        let mut c = Controls::default();
+        for spec in modal_resonator::engine::NUMERIC_CONTROLS {
+            let v = if next() < 0.2 {
+                specials[(next() * 6.99) as usize]
+            } else {
+                spec.min + next() * (spec.max - spec.min)
+            };
+            (spec.set)(&mut c, v);
+        }
+        c.material_q = Some(if next() < 0.5 { 1e-3 } else { 1e9 });
+        e.set_controls(&c);
+        for (i, x) in input.iter_mut().enumerate() {
+            *x = if (block + i) % 97 == 0 {
+                specials[i % 7]
+            } else {
+                (next() - 0.5) * 4.0
+            };
+        }
+        let key = (next() * 127.0) as u8;
+        let events = [
+            on((next() * 255.0) as u32, key, next() * 1.5),
+            NoteEvent::On {
+                time: 255,
+                key,
+                velocity: f32::NAN,
+            },
+        ];
+        e.process(&events, Some(&input), &mut l, &mut r);
+        for (i, v) in l.iter().chain(&r).enumerate() {
+            assert!(v.is_finite(), "block {block}: sample {i} is {v}");
+        }
+    }
+}
+
+#[test]
+fn long_tails_stay_clear_of_denormals() {
+    let bank = simple_bank(&[(50.0, 0.5, 1.0), (3_000.0, 50.0, 0.5)]);
+    let mut e = engine(&bank, RATE);
+    let mut c = e.controls().clone();
+    c.truncation_db = -140.0;
+    e.set_controls(&c);
+    let (l, r) = render(&mut e, &[on(0, 43, 1.0)], 20.0, 512);
+    let subnormal = l.iter().chain(&r).filter(|v| v.is_subnormal()).count();
+    assert_eq!(subnormal, 0);
+}
+
+#[test]
+fn audio_input_drives_the_modes() {
+    let bank = simple_bank(&[(440.0, 5.0, 1.0), (1_320.0, 5.0, 1.0)]);
+    let mut e = engine(&bank, RATE);
+    let n = 9_600;
+    // A click train at 10 Hz rings the object.
+    let input: Vec<f32> = (0..n)
+        .map(|i| if i % 4_800 == 0 { 0.5 } else { 0.0 })
+        .collect();
+    let (mut l, mut r) = (vec![0.0; n], vec![0.0; n]);
+    e.process(&[], Some(&input), &mut l, &mut r);
+    assert!(
+        peak(&l) > 0.05,
+        "input did not excite the modes: peak {}",
+        peak(&l)
+    );
+    let got = pitch_hz(&l[10..4_000], RATE as f64, 300.0, 600.0);
+    assert!((got / 440.0 - 1.0).abs() < 0.003, "input voice at {got} Hz");
+    // Silence in, silence out once the ring has died.
+    let silence = vec![0.0f32; 48_000];
+    let (mut l, mut r) = (vec![0.0; 48_000], vec![0.0; 48_000]);
+    for _ in 0..10 {
+        e.process(&[], Some(&silence), &mut l, &mut r);
+    }
+    assert!(e.is_silent());
+    assert_eq!(peak(&l), 0.0);
+}
+
+#[test]
+fn all_sound_off_silences_at_once_and_all_notes_off_releases() {
+    let bank = dense_bank(30, 220.0);
+    let mut e = engine(&bank, RATE);
+    let (l, _) = render(
+        &mut e,
+        &[
+            on(0, 57, 1.0),
+            on(0, 60, 1.0),
+            NoteEvent::AllSoundOff { time: 1_000 },
+        ],
+        0.05,
+        256,
+    );
+    assert!(peak(&l[..1_000]) > 0.01);
+    assert_eq!(peak(&l[1_000..]), 0.0);
+    assert!(e.is_silent());
+
+    let mut e = engine(&bank, RATE);
+    let mut c = e.controls().clone();
+    c.release_damping = 1.0;
+    e.set_controls(&c);
+    let (l, _) = render(
+        &mut e,
+        &[on(0, 57, 1.0), NoteEvent::AllNotesOff { time: 1_000 }],
+        1.0,
+        256,
+    );
+    assert!(
+        peak(&l[24_000..]) < 1e-3,
+        "released notes should have damped"
+    );
+    assert!(e.is_silent());
+}

@@ -1,0 +1,131 @@
+//! The engine's process call never allocates: a counting global allocator watches it through note
+//! storms, control sweeps, audio input, re-strikes, stealing and resets.
+
+mod common;
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+use common::*;
+use modal_resonator::dsp::ExciterKind;
+use modal_resonator::engine::{Controls, NoteEvent, NUMERIC_CONTROLS};
+
+struct Counting;
+
+thread_local! {
+    /// Allocations made on this thread while `WATCHING` is set.
+    static COUNT: Cell<usize> = const { Cell::new(0) };
+    static WATCHING: Cell<bool> = const { Cell::new(false) };
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        if WATCHING.with(|w| w.get()) {
+            COUNT.with(|c| c.set(c.get() + 1));
+        }
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        if WATCHING.with(|w| w.get()) {
+            COUNT.with(|c| c.set(c.get() + 1));
+        }
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        if WATCHING.with(|w| w.get()) {
+            COUNT.with(|c| c.set(c.get() + 1));
+        }
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+/// Runs `f` and returns how many allocations and frees it made on this thread.
+fn allocations_in(f: impl FnOnce()) -> usize {
+    COUNT.with(|c| c.set(0));
+    WATCHING.with(|w| w.set(true));
+    f();
+    WATCHING.with(|w| w.set(false));
+    COUNT.with(|c| c.get())
+}
+
+#[test]
+fn process_never_allocates() {
+    let bank = dense_bank(700, 55.0);
+    let mut e = engine(&bank, 48_000.0);
+    let block = 256;
+    let (mut l, mut r) = (vec![0.0f32; block], vec![0.0f32; block]);
+    let input: Vec<f32> = (0..block)
+        .map(|i| ((i * 7919) % 101) as f32 / 101.0 - 0.5)
+        .collect();
+    // Controls for every block, built before watching.
+    let sweeps: Vec<Controls> = (0..200)
+        .map(|b| {
+            let mut c = Controls::default();
+            let t = b as f32 / 199.0;
+            for spec in NUMERIC_CONTROLS {
+                (spec.set)(
+                    &mut c,
+                    spec.min + (spec.max - spec.min) * ((t * 7.0 + spec.min.abs()) % 1.0),
+                );
+            }
+            c.polyphony = 1 + b % 64;
+            c.material_q = if b % 3 == 0 {
+                None
+            } else {
+                Some(10.0 + 50.0 * b as f32)
+            };
+            c.exciter = ExciterKind::ALL[b % 3];
+            c
+        })
+        .collect();
+    let storms: Vec<Vec<NoteEvent>> = (0..200)
+        .map(|b| {
+            (0..40)
+                .map(|i| {
+                    let time = ((i * 37 + b * 11) % block) as u32;
+                    match i % 5 {
+                        4 => NoteEvent::Off {
+                            time,
+                            key: ((i * 13 + b) % 128) as u8,
+                        },
+                        _ => NoteEvent::On {
+                            time,
+                            key: ((i * 29 + b * 3) % 128) as u8,
+                            velocity: (i % 10) as f32 / 9.0,
+                        },
+                    }
+                })
+                .collect::<Vec<_>>()
+        })
+        .map(|mut v| {
+            v.sort_by_key(|e| e.time());
+            v
+        })
+        .collect();
+    let count = allocations_in(|| {
+        for b in 0..200 {
+            e.set_controls(&sweeps[b]);
+            let input = (b % 2 == 0).then_some(&input[..]);
+            e.process(&storms[b], input, &mut l, &mut r);
+            if b == 100 {
+                e.reset();
+            }
+        }
+        e.process(
+            &[
+                NoteEvent::AllNotesOff { time: 0 },
+                NoteEvent::AllSoundOff { time: 10 },
+            ],
+            None,
+            &mut l,
+            &mut r,
+        );
+    });
+    assert_eq!(count, 0, "process allocated or freed {count} times");
+    // The counter works: an allocation outside the engine is seen.
+    let seen = allocations_in(|| drop(std::hint::black_box(vec![1u8; 10])));
+    assert!(seen >= 1);
+}
