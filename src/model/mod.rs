@@ -3,5 +3,6 @@
 //! Nothing here runs on the audio thread: code in this module may allocate and may fail.
 
 pub mod bank;
+pub mod materials;
 
 pub use bank::{Bank, BankDefaults, Mode, Position};
