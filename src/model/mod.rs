@@ -4,5 +4,6 @@
 
 pub mod bank;
 pub mod materials;
+pub mod shapes;
 
 pub use bank::{Bank, BankDefaults, Mode, Position};
