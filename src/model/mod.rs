@@ -3,8 +3,11 @@
 //! Nothing here runs on the audio thread: code in this module may allocate and may fail.
 
 pub mod bank;
+pub mod factory;
 pub mod io;
+pub mod materials;
 pub mod schema;
+pub mod shapes;
 pub mod validate;
 
 pub use bank::{Bank, BankDefaults, Mode, Position};
