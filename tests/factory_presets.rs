@@ -1,11 +1,11 @@
 //! The committed factory presets match what `src/model/factory.rs` generates.
 //!
-//! `UPDATE_PRESETS=1 cargo test factory_presets` rewrites `presets/<slug>.json` and
-//! `presets/FACTORY.md` instead of checking them.
+//! `UPDATE_PRESETS=1 cargo test factory_presets` rewrites `presets/<slug>.json` and the factory
+//! table in `presets/README.md` instead of checking them.
 
 use modal_resonator::model::factory::{
-    factory_banks, factory_slug, factory_table_markdown, first_difference, write_factory_presets,
-    FACTORY_TABLE_FILE,
+    factory_banks, factory_slug, factory_table_markdown, first_difference, splice_factory_table,
+    write_factory_presets, FACTORY_TABLE_FILE,
 };
 use modal_resonator::model::Bank;
 use std::path::PathBuf;
@@ -31,7 +31,11 @@ fn factory_presets_are_up_to_date() {
     let table = factory_table_markdown(&banks);
     if updating() {
         let paths = write_factory_presets(&dir).expect("writing the factory presets");
-        std::fs::write(dir.join(FACTORY_TABLE_FILE), &table).expect("writing the table");
+        let readme_path = dir.join(FACTORY_TABLE_FILE);
+        let readme = std::fs::read_to_string(&readme_path).expect("reading presets/README.md");
+        let readme = splice_factory_table(&readme, &table)
+            .expect("factory table markers in presets/README.md");
+        std::fs::write(readme_path, readme).expect("writing the table");
         eprintln!("wrote {} presets and {FACTORY_TABLE_FILE}", paths.len());
         return;
     }
@@ -60,7 +64,8 @@ fn factory_presets_are_up_to_date() {
     }
     let table_path = dir.join(FACTORY_TABLE_FILE);
     match std::fs::read_to_string(&table_path) {
-        Ok(committed) if committed == table => {}
+        Ok(committed)
+            if splice_factory_table(&committed, &table).as_deref() == Some(committed.as_str()) => {}
         Ok(_) => stale.push(format!("{} differs", table_path.display())),
         Err(err) => stale.push(format!("{}: {err}", table_path.display())),
     }

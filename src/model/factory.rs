@@ -13,11 +13,20 @@ use crate::model::Bank;
 use std::path::{Path, PathBuf};
 
 /// Name of the generated table of factory banks, next to the presets.
-pub const FACTORY_TABLE_FILE: &str = "FACTORY.md";
+pub const FACTORY_TABLE_FILE: &str = "README.md";
 
-/// Equal-tempered pitch in Hz of a MIDI key (A4 = key 69 = 440 Hz).
-fn midi_key_to_hz(key: u8) -> f64 {
-    440.0 * ((f64::from(key) - 69.0) / 12.0).exp2()
+/// Marks the start of the generated factory table in `presets/README.md`.
+pub const FACTORY_TABLE_BEGIN: &str = "<!-- factory table: generated, do not edit -->\n";
+
+/// Marks the end of the generated factory table in `presets/README.md`.
+pub const FACTORY_TABLE_END: &str = "<!-- end of factory table -->\n";
+
+/// `readme` with the text between the factory table markers replaced by `table`, or `None` when
+/// the markers are missing.
+pub fn splice_factory_table(readme: &str, table: &str) -> Option<String> {
+    let start = readme.find(FACTORY_TABLE_BEGIN)? + FACTORY_TABLE_BEGIN.len();
+    let end = start + readme[start..].find(FACTORY_TABLE_END)?;
+    Some(format!("{}{}{}", &readme[..start], table, &readme[end..]))
 }
 
 /// MIDI keys of the pitches the factory objects are tuned to.
@@ -179,7 +188,10 @@ impl FactoryObject {
     fn build(&self) -> Bank {
         let shape = self
             .shape
-            .tuned_to(self.material, midi_key_to_hz(self.root_key))
+            .tuned_to(
+                self.material,
+                crate::dsp::coeffs::midi_key_to_hz(f64::from(self.root_key)),
+            )
             .unwrap_or_else(|e| panic!("factory bank {:?}: {e}", self.name));
         let description = format!("{} {}", self.description, shape.summary(self.material));
         build_bank(
@@ -232,9 +244,7 @@ pub fn factory_bank(name_or_slug: &str) -> Option<Bank> {
 
 /// The text of a bank's preset file: pretty JSON and a trailing newline.
 pub fn preset_json(bank: &Bank) -> String {
-    let mut text = serde_json::to_string_pretty(bank).expect("a bank always serialises");
-    text.push('\n');
-    text
+    crate::model::io::bank_to_json(bank)
 }
 
 /// Writes every factory bank to `dir/<slug>.json`, creating `dir` if needed; returns the paths.
@@ -324,11 +334,10 @@ fn note_name(freq_hz: f64) -> String {
     }
 }
 
-/// The Markdown table of the factory banks written to `presets/FACTORY.md`.
+/// The Markdown table of the factory banks, kept in `presets/README.md`.
 pub fn factory_table_markdown(banks: &[Bank]) -> String {
     let mut text = String::from(
-        "# Factory banks\n\n\
-         Generated from `src/model/factory.rs` by `UPDATE_PRESETS=1 cargo test factory_presets`; \
+        "Generated from `src/model/factory.rs` by `UPDATE_PRESETS=1 cargo test factory_presets`; \
          do not edit by hand. Every bank is analytic (`source.kind = \"analytic\"`): closed-form \
          modes of the object (`src/model/shapes/`), decays from the material \
          (`src/model/materials.rs`), gains `Psi_n(p) / omega_n` at each strike position.\n\n\

@@ -215,10 +215,7 @@ impl Material {
     }
 }
 
-/// T60 in seconds of an exponential decay at `decay_per_s` (amplitude falls by 60 dB).
-pub fn decay_to_t60_s(decay_per_s: f64) -> f64 {
-    3.0 * std::f64::consts::LN_10 / decay_per_s
-}
+pub use crate::dsp::coeffs::decay_to_t60_s;
 
 #[cfg(test)]
 mod tests {
