@@ -104,6 +104,8 @@ struct Smoothed {
     weights: ([f32; COLUMNS], [f32; COLUMNS]),
     /// Per-sample change of the weights while ramping.
     weight_step: ([f32; COLUMNS], [f32; COLUMNS]),
+    /// Where the weight ramp ends.
+    weight_target: ([f32; COLUMNS], [f32; COLUMNS]),
     /// Samples left in the weight ramp.
     weight_ramp_left: usize,
 }
@@ -156,6 +158,7 @@ impl Engine {
             tilt: 0.0,
             gain: 1.0,
             weights: lane_weights(controls.width),
+            weight_target: lane_weights(controls.width),
             weight_step: ([0.0; COLUMNS], [0.0; COLUMNS]),
             weight_ramp_left: 0,
         };
@@ -239,6 +242,7 @@ impl Engine {
             tilt,
             gain: db_to_gain(self.controls.output_gain_db),
             weights: lane_weights(self.controls.width),
+            weight_target: lane_weights(self.controls.width),
             weight_step: ([0.0; COLUMNS], [0.0; COLUMNS]),
             weight_ramp_left: 0,
         };

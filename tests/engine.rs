@@ -30,9 +30,11 @@ fn block_size_does_not_change_the_output() {
 #[test]
 fn reset_reproduces_the_output_exactly() {
     let bank = dense_bank(200, 220.0);
-    let mut controls = Controls::default();
-    controls.position_variation = 0.3;
-    controls.exciter = modal_resonator::dsp::ExciterKind::Noise;
+    let controls = Controls {
+        position_variation: 0.3,
+        exciter: modal_resonator::dsp::ExciterKind::Noise,
+        ..Controls::default()
+    };
     let mut e = engine(&bank, RATE);
     e.set_controls(&controls);
     let events = [on(0, 57, 0.9), on(2400, 60, 0.7)];
@@ -222,11 +224,11 @@ fn parameter_changes_while_ringing_do_not_click() {
         );
     }
     // A 2-semitone bend in 10 ms lands on the new pitch.
-    let (l, _) = sweep(&simple_bank(&[(220.0, 1.0, 1.0)]), &{
-        let mut c = Controls::default();
-        c.pitch_bend_semitones = 2.0;
-        c
-    });
+    let bent = Controls {
+        pitch_bend_semitones: 2.0,
+        ..Controls::default()
+    };
+    let (l, _) = sweep(&simple_bank(&[(220.0, 1.0, 1.0)]), &bent);
     let got = pitch_hz(&l[4_800 + 480..], RATE as f64, 150.0, 400.0);
     let want = 220.0 * 2f64.powf(2.0 / 12.0);
     assert!(

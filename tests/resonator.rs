@@ -112,7 +112,7 @@ fn impulse_response_has_the_requested_frequency_and_t60() {
 fn assorted_mode(m: usize) -> (ModeCoeffs, f32) {
     let f = 40.0 + (m as f64 * 131.7) % 21_000.0;
     let d = 0.5 + (m % 17) as f64 * 3.0;
-    let g = if m % 3 == 0 { -1.0 } else { 1.0 } / (1.0 + m as f32 * 0.05);
+    let g = if m.is_multiple_of(3) { -1.0 } else { 1.0 } / (1.0 + m as f32 * 0.05);
     (ModeCoeffs::from_freq_decay(48_000.0, f, d), g)
 }
 
@@ -129,8 +129,8 @@ fn assorted(n: usize) -> ResonatorBank {
 /// A mallet-like pulse at the start, then silence, then a second strike.
 fn strike_input(len: usize) -> Vec<f32> {
     let mut x = vec![0.0f32; len];
-    for n in 0..24 {
-        x[n] = (1.0 - (std::f32::consts::TAU * (n as f32 + 0.5) / 24.0).cos()) / 24.0;
+    for (n, v) in x.iter_mut().take(24).enumerate() {
+        *v = (1.0 - (std::f32::consts::TAU * (n as f32 + 0.5) / 24.0).cos()) / 24.0;
     }
     x[len / 2] = 0.7;
     x

@@ -119,7 +119,7 @@ mod tests {
     fn q_matches_pole_minus_one() {
         for &(theta, delta) in &[(0.001, 1e-6), (0.5, 1e-3), (2.8, 0.2)] {
             let c = ModeCoeffs::from_angle_radius(theta, delta);
-            let r = (-delta as f64).exp();
+            let r = (-delta).exp();
             let want_re = r * theta.cos() - 1.0;
             let want_im = r * theta.sin();
             assert!(

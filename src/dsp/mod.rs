@@ -5,6 +5,7 @@
 //! paths never allocate.
 
 pub mod coeffs;
+pub mod coeffs_batch;
 pub mod denormal;
 pub mod exciter;
 pub mod kernels;

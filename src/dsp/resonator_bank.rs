@@ -10,6 +10,7 @@
 //! (a string struck at its middle) still fills every lane.
 
 use super::coeffs::ModeCoeffs;
+use super::coeffs_batch::coeffs_batch;
 pub use super::kernels::COLUMNS;
 use super::kernels::{self, Kernel, Rows, ROW_BLOCK};
 
@@ -37,6 +38,10 @@ pub struct ResonatorBank {
     live: [u32; COLUMNS],
     /// Rows handed to the kernel: the fullest column, rounded up to whole row blocks.
     rows_active: usize,
+    /// Scratch: pole angle of each slot, for batch coefficient updates.
+    theta: Vec<f64>,
+    /// Scratch: pole radius exponent of each slot, for batch coefficient updates.
+    delta: Vec<f64>,
 }
 
 impl ResonatorBank {
@@ -54,6 +59,8 @@ impl ResonatorBank {
             slot_of_mode: vec![NONE; num_modes],
             live: [0; COLUMNS],
             rows_active: 0,
+            theta: vec![0.0; slots],
+            delta: vec![0.0; slots],
         }
     }
 
@@ -105,6 +112,28 @@ impl ResonatorBank {
         self.slot_of_mode[mode] = slot as u32;
         self.update_rows();
         true
+    }
+
+    /// Sets the coefficients of every live mode to those of the pole `pole_of(mode) = (theta,
+    /// delta)` (angle in radians per sample, radius `exp(-delta)`; see
+    /// [`ModeCoeffs::from_angle_radius`]), computed for all modes at once.
+    pub fn set_poles_with(&mut self, mut pole_of: impl FnMut(usize) -> (f64, f64)) {
+        let n = self.rows_active * COLUMNS;
+        for slot in 0..n {
+            let mode = self.mode_of_slot[slot];
+            // A pole at (0, 0) gives coefficients (0, 0): empty slots stay silent.
+            (self.theta[slot], self.delta[slot]) = if mode == NONE {
+                (0.0, 0.0)
+            } else {
+                pole_of(mode as usize)
+            };
+        }
+        coeffs_batch(
+            &self.theta[..n],
+            &self.delta[..n],
+            &mut self.q_re[..n],
+            &mut self.q_im[..n],
+        );
     }
 
     /// Sets the coefficients of every live mode to `coeffs_of(mode)`.
@@ -164,8 +193,8 @@ impl ResonatorBank {
             for row in (0..self.live[column] as usize).rev() {
                 let slot = row * COLUMNS + column;
                 let e = self.re[slot] * self.re[slot] + self.im[slot] * self.im[slot];
-                // `!(e >= t)` also retires a mode whose state is not a number.
-                if !(e >= threshold_sq) {
+                // A state that is not a number is retired too.
+                if e.is_nan() || e < threshold_sq {
                     self.remove_slot(slot);
                     changed = true;
                 } else {

@@ -28,7 +28,7 @@ impl Engine {
         let mut next_event = 0;
         let mut pos = 0;
         while pos < len {
-            if self.clock % CONTROL_PERIOD as u64 == 0 {
+            if self.clock.is_multiple_of(CONTROL_PERIOD as u64) {
                 self.control_tick();
             }
             while next_event < events.len()
@@ -103,6 +103,7 @@ impl Engine {
                 self.smoothed.weight_step.0[j] = (target.0[j] - self.smoothed.weights.0[j]) * inv;
                 self.smoothed.weight_step.1[j] = (target.1[j] - self.smoothed.weights.1[j]) * inv;
             }
+            self.smoothed.weight_target = target;
             self.smoothed.weight_ramp_left = CONTROL_PERIOD;
         }
 
@@ -253,9 +254,6 @@ impl Engine {
         }
         v.state = VoiceState::Held;
         let tuning = tuning_of(&self.voices[i], self.damping_version, self.release_decay());
-        if self.voices[i].applied != Some(tuning) {
-            self.voices[i].retune(&self.bank, &self.decay, self.sample_rate_hz, tuning);
-        }
 
         let c = &self.controls;
         let vary = c.position_variation;
@@ -335,7 +333,6 @@ impl Engine {
                         .positions
                         .weights(self.controls.strike_x, self.controls.strike_y);
                     let tuning = tuning_of(v, self.damping_version, 0.0);
-                    v.retune(&self.bank, &self.decay, self.sample_rate_hz, tuning);
                     // Every mode in range; the strike itself adds nothing (amplitude 0).
                     v.strike(
                         &self.bank,
@@ -369,14 +366,14 @@ impl Engine {
                     s.weights.1[j] += s.weight_step.1[j];
                 }
                 if s.weight_ramp_left == 0 {
-                    s.weights = lane_weights(self.controls.width);
+                    s.weights = s.weight_target;
                 }
             }
             s.gain += (target_gain - s.gain) * gain_k;
             let (mut sl, mut sr) = (0.0, 0.0);
-            for j in 0..COLUMNS {
-                sl += a[j] * s.weights.0[j];
-                sr += a[j] * s.weights.1[j];
+            for ((x, wl), wr) in a.iter().zip(&s.weights.0).zip(&s.weights.1) {
+                sl += x * wl;
+                sr += x * wr;
             }
             *l = sl * s.gain;
             *r = sr * s.gain;

@@ -93,27 +93,9 @@ impl Voice {
         self.fade_gain = 1.0;
     }
 
-    /// Coefficients of mode `m` at `tuning`, given the decay table and the sample rate.
-    #[inline]
-    fn coeffs(
-        bank: &PreparedBank,
-        decay: &[f64],
-        sample_rate_hz: f64,
-        pitch: f64,
-        release: f64,
-        m: usize,
-    ) -> ModeCoeffs {
-        let theta = TAU * bank.freq_hz[m] * pitch / sample_rate_hz;
-        let decay_per_s = (decay[m] * pitch).max(release);
-        if theta >= THETA_MAX {
-            let fade = t60_to_decay(ABOVE_RANGE_T60_S).max(decay_per_s);
-            ModeCoeffs::from_angle_radius(THETA_MAX, fade / sample_rate_hz)
-        } else {
-            ModeCoeffs::from_angle_radius(theta, decay_per_s / sample_rate_hz)
-        }
-    }
-
-    /// Recomputes the coefficients of every live mode for `tuning`.
+    /// Recomputes the coefficients of every live mode for `tuning`: angles scale with pitch,
+    /// decays follow frequency (constant Q) with the release decay as a floor, and a mode pushed
+    /// above `THETA_MAX` is held there and fades out.
     pub fn retune(
         &mut self,
         bank: &PreparedBank,
@@ -122,15 +104,25 @@ impl Voice {
         tuning: Tuning,
     ) {
         let pitch = tuning.log_pitch.exp();
+        let theta_per_hz = TAU * pitch / sample_rate_hz;
+        let inv_rate = 1.0 / sample_rate_hz;
         let release = tuning.release_decay_per_s;
-        self.modes
-            .set_coeffs_with(|m| Self::coeffs(bank, decay, sample_rate_hz, pitch, release, m));
+        let fade = t60_to_decay(ABOVE_RANGE_T60_S);
+        self.modes.set_poles_with(|m| {
+            let theta = bank.freq_hz[m] * theta_per_hz;
+            let decay_per_s = (decay[m] * pitch).max(release);
+            if theta < THETA_MAX {
+                (theta, decay_per_s * inv_rate)
+            } else {
+                (THETA_MAX, decay_per_s.max(fade) * inv_rate)
+            }
+        });
         self.applied = Some(tuning);
     }
 
     /// Strikes the voice: restarts modes that have died (unless the strike cannot lift them above
-    /// `threshold`), sets every mode's gain for the strike point `weights`, and starts the pulse.
-    /// The voice's coefficients must be current (`applied == Some(tuning)`).
+    /// `threshold`), sets every mode's gain for the strike point `weights`, tunes the voice to
+    /// `tuning` and starts the pulse.
     #[allow(clippy::too_many_arguments)] // one call site; the values are all distinct and plain
     pub fn strike(
         &mut self,
@@ -153,18 +145,19 @@ impl Voice {
             let gain = bank.gain_at(m, weights);
             let theta = TAU * bank.freq_hz[m] * pitch / sample_rate_hz;
             if theta < THETA_MAX && gain.abs() * bound >= threshold {
-                let c = Self::coeffs(
-                    bank,
-                    decay,
-                    sample_rate_hz,
-                    pitch,
-                    tuning.release_decay_per_s,
+                // Coefficients follow below, for all modes at once.
+                self.modes.activate(
                     m,
+                    ModeCoeffs {
+                        q_re: 0.0,
+                        q_im: 0.0,
+                    },
+                    gain,
                 );
-                self.modes.activate(m, c, gain);
             }
         }
         self.modes.set_gains_with(|m| bank.gain_at(m, weights));
+        self.retune(bank, decay, sample_rate_hz, tuning);
         self.exciter.strike(kind, amplitude, len_samples);
     }
 }
