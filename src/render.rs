@@ -24,6 +24,10 @@ use crate::model::Bank;
 /// player does not cut the very end of the tail.
 pub const TAIL_MARGIN_S: f64 = 0.1;
 
+/// Most samples per channel reserved up front (about 87 s at 48 kHz): the tail estimate can be
+/// far longer than the sound when notes are released early.
+const MAX_RESERVED_SAMPLES: usize = 1 << 22;
+
 /// How to render.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RenderSettings {
@@ -260,8 +264,9 @@ pub fn render(
         .min(max_samples as f64)
         .max(1.0);
 
-    let mut left: Vec<f32> = Vec::with_capacity(estimated_len as usize);
-    let mut right: Vec<f32> = Vec::with_capacity(estimated_len as usize);
+    let reserved = (estimated_len as usize).min(MAX_RESERVED_SAMPLES);
+    let mut left: Vec<f32> = Vec::with_capacity(reserved);
+    let mut right: Vec<f32> = Vec::with_capacity(reserved);
     let mut block_events = Vec::with_capacity(events.len().min(4096));
     let mut next = 0;
     let mut pos = 0u64;
