@@ -1,1 +1,315 @@
-//! Offline rendering over the engine.
+//! Offline rendering over the engine: notes in seconds in, stereo samples out.
+//!
+//! [`render`] drives one [`Engine`] exactly as a plugin host would: fixed blocks, note events at
+//! their exact sample inside a block, nothing else. The same notes and settings give the same
+//! samples bit for bit, whatever the block size.
+
+mod midi_file;
+mod notes;
+mod wav;
+
+use std::fmt;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+pub use midi_file::read_midi_file;
+pub use notes::{parse_notes, Note};
+pub use wav::{to_int_sample, write_wav, BitDepth};
+
+use crate::dsp::coeffs::{db_to_gain, gain_to_db};
+use crate::engine::{Controls, Engine, NoteEvent, PreparedBank};
+use crate::model::Bank;
+
+/// Silence kept after the last sound (or the last event, if later), in seconds: enough that a
+/// player does not cut the very end of the tail.
+pub const TAIL_MARGIN_S: f64 = 0.1;
+
+/// Most samples per channel reserved up front (about 87 s at 48 kHz): the tail estimate can be
+/// far longer than the sound when notes are released early.
+const MAX_RESERVED_SAMPLES: usize = 1 << 22;
+
+/// How to render.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderSettings {
+    /// Sample rate in Hz, at least 8000.
+    pub sample_rate_hz: u32,
+    /// Sample format of the file the render is meant for.
+    pub bit_depth: BitDepth,
+    /// The engine's controls for the whole render.
+    pub controls: Controls,
+    /// Longest render in seconds: rendering stops here even if the sound goes on.
+    pub max_seconds: f64,
+    /// Samples per call to [`Engine::process`], as a host's buffer size.
+    pub block: usize,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        Self {
+            sample_rate_hz: 48_000,
+            bit_depth: BitDepth::Int24,
+            controls: Controls::default(),
+            max_seconds: 30.0,
+            block: 512,
+        }
+    }
+}
+
+impl RenderSettings {
+    /// The defaults with the bank's own default controls.
+    pub fn for_bank(bank: &Bank) -> Self {
+        Self {
+            controls: Controls::for_bank(bank),
+            ..Self::default()
+        }
+    }
+}
+
+/// A finished render.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rendered {
+    /// Left channel.
+    pub left: Vec<f32>,
+    /// Right channel, as long as the left.
+    pub right: Vec<f32>,
+    /// Sample rate in Hz.
+    pub sample_rate_hz: u32,
+    /// Most voices sounding at the end of any block.
+    pub max_voices: usize,
+    /// Whether `max_seconds` cut the render while it still sounded or had notes to play.
+    pub cut_short: bool,
+}
+
+impl Rendered {
+    /// Length in samples per channel.
+    pub fn len(&self) -> usize {
+        self.left.len()
+    }
+
+    /// Whether there are no samples.
+    pub fn is_empty(&self) -> bool {
+        self.left.is_empty()
+    }
+
+    /// Length in seconds.
+    pub fn duration_s(&self) -> f64 {
+        self.len() as f64 / self.sample_rate_hz as f64
+    }
+
+    /// Largest absolute sample of either channel.
+    pub fn peak(&self) -> f32 {
+        self.left
+            .iter()
+            .chain(&self.right)
+            .fold(0.0, |a, x| a.max(x.abs()))
+    }
+
+    /// Peak level in dBFS (negative infinity for silence).
+    pub fn peak_dbfs(&self) -> f32 {
+        match self.peak() {
+            0.0 => f32::NEG_INFINITY,
+            peak => gain_to_db(peak),
+        }
+    }
+}
+
+/// Why reading notes or writing audio failed. Every error names the file.
+#[derive(Debug)]
+pub enum RenderError {
+    /// A file could not be read or written.
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        source: std::io::Error,
+    },
+    /// A MIDI file could not be parsed.
+    Midi {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// A WAV file could not be written.
+    Wav {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        source: hound::Error,
+    },
+}
+
+impl fmt::Display for RenderError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            RenderError::Io { path, source } => write!(f, "{}: {source}", path.display()),
+            RenderError::Midi { path, message } => write!(f, "{}: {message}", path.display()),
+            RenderError::Wav { path, source } => {
+                write!(f, "{}: cannot write WAV: {source}", path.display())
+            }
+        }
+    }
+}
+
+impl std::error::Error for RenderError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            RenderError::Io { source, .. } => Some(source),
+            RenderError::Midi { .. } => None,
+            RenderError::Wav { source, .. } => Some(source),
+        }
+    }
+}
+
+/// A note event at an absolute sample time.
+#[derive(Debug, Clone, Copy)]
+struct TimedEvent {
+    /// Sample from the start of the render.
+    sample: u64,
+    /// Order among events on the same sample: releases of earlier notes, then strikes, then
+    /// releases of notes struck on that very sample.
+    rank: u8,
+    /// The event, with its time set when its block is known.
+    event: NoteEvent,
+}
+
+/// The events of `notes` at `rate`, in the order the engine must see them.
+fn schedule(notes: &[Note], rate: f64) -> Vec<TimedEvent> {
+    let to_sample = |t: f64| (t * rate).round().max(0.0) as u64;
+    let mut events = Vec::with_capacity(2 * notes.len());
+    for note in notes {
+        let on = to_sample(note.time_s);
+        events.push(TimedEvent {
+            sample: on,
+            rank: 1,
+            event: NoteEvent::On {
+                time: 0,
+                key: note.key,
+                velocity: note.velocity,
+            },
+        });
+        if let Some(release_s) = note.release_s() {
+            let off = to_sample(release_s).max(on);
+            events.push(TimedEvent {
+                sample: off,
+                rank: if off == on { 2 } else { 0 },
+                event: NoteEvent::Off {
+                    time: 0,
+                    key: note.key,
+                },
+            });
+        }
+    }
+    // Stable, so simultaneous strikes keep the order they were given in.
+    events.sort_by_key(|e| (e.sample, e.rank));
+    events
+}
+
+/// `event` at sample `time` of its block.
+fn at(event: NoteEvent, time: u32) -> NoteEvent {
+    match event {
+        NoteEvent::On { key, velocity, .. } => NoteEvent::On {
+            time,
+            key,
+            velocity,
+        },
+        NoteEvent::Off { key, .. } => NoteEvent::Off { time, key },
+        NoteEvent::AllNotesOff { .. } => NoteEvent::AllNotesOff { time },
+        NoteEvent::AllSoundOff { .. } => NoteEvent::AllSoundOff { time },
+    }
+}
+
+/// Seconds until the longest-ringing mode of `bank` falls below the truncation threshold after a
+/// full strike at the root pitch: an estimate of a note's tail, for progress reports only.
+fn estimated_tail_s(bank: &PreparedBank, controls: &Controls) -> f64 {
+    let log_damping = bank.log_damping(controls.material_q);
+    let threshold = db_to_gain(controls.truncation_db) as f64;
+    (0..bank.num_modes())
+        .map(|m| {
+            let row = &bank.gains[m * bank.num_positions..(m + 1) * bank.num_positions];
+            let gain = row.iter().fold(0.0f64, |a, g| a.max(g.abs() as f64));
+            let decay = bank.damped_decay(m, log_damping, controls.damping_tilt as f64);
+            (gain / threshold).ln() / decay
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Renders `notes` (in any order) through `bank` with `settings`, calling `progress` with the
+/// fraction done (0 to 1, an estimate until the end) after each block.
+///
+/// Stops at `settings.max_seconds`, or once every note has been played and released and the
+/// engine is silent; a silent render is then trimmed to [`TAIL_MARGIN_S`] after its last sound
+/// or last event, so its length does not depend on the block size either.
+///
+/// # Panics
+/// If the sample rate is below 8000 Hz.
+pub fn render(
+    bank: &Arc<PreparedBank>,
+    notes: &[Note],
+    settings: &RenderSettings,
+    mut progress: impl FnMut(f64),
+) -> Rendered {
+    let rate = settings.sample_rate_hz as f64;
+    let block = settings.block.max(1);
+    let max_samples = (settings.max_seconds.max(0.0) * rate).round() as u64;
+    let mut engine = Engine::new(Arc::clone(bank));
+    engine.set_controls(&settings.controls);
+    engine.prepare(settings.sample_rate_hz as f32, block);
+
+    let mut events = schedule(notes, rate);
+    let dropped = events.iter().any(|e| e.sample >= max_samples);
+    events.retain(|e| e.sample < max_samples);
+    let last_event_end = events.last().map_or(0, |e| e.sample + 1);
+    let estimated_len = (last_event_end as f64 + estimated_tail_s(bank, engine.controls()) * rate)
+        .min(max_samples as f64)
+        .max(1.0);
+
+    let reserved = (estimated_len as usize).min(MAX_RESERVED_SAMPLES);
+    let mut left: Vec<f32> = Vec::with_capacity(reserved);
+    let mut right: Vec<f32> = Vec::with_capacity(reserved);
+    let mut block_events = Vec::with_capacity(events.len().min(4096));
+    let mut next = 0;
+    let mut pos = 0u64;
+    let mut max_voices = 0;
+    let mut done = 0.0f64;
+    let finished = |next: usize, engine: &Engine| next == events.len() && engine.is_silent();
+    while pos < max_samples && !finished(next, &engine) {
+        let len = (block as u64).min(max_samples - pos);
+        block_events.clear();
+        while next < events.len() && events[next].sample < pos + len {
+            block_events.push(at(events[next].event, (events[next].sample - pos) as u32));
+            next += 1;
+        }
+        let start = pos as usize;
+        left.resize(start + len as usize, 0.0);
+        right.resize(start + len as usize, 0.0);
+        engine.process(&block_events, None, &mut left[start..], &mut right[start..]);
+        max_voices = max_voices.max(engine.stats().voices);
+        pos += len;
+        done = done.max((pos as f64 / estimated_len).min(0.99));
+        progress(done);
+    }
+
+    let sounding = !finished(next, &engine);
+    let end = if sounding {
+        pos
+    } else {
+        let last_sound_end = left
+            .iter()
+            .zip(&right)
+            .rposition(|(l, r)| *l != 0.0 || *r != 0.0)
+            .map_or(0, |i| i as u64 + 1);
+        let margin = (TAIL_MARGIN_S * rate).round() as u64;
+        (last_sound_end.max(last_event_end) + margin).min(max_samples)
+    };
+    left.resize(end as usize, 0.0);
+    right.resize(end as usize, 0.0);
+    progress(1.0);
+    Rendered {
+        left,
+        right,
+        sample_rate_hz: settings.sample_rate_hz,
+        max_voices,
+        cut_short: sounding || dropped,
+    }
+}

@@ -1,0 +1,162 @@
+//! Standard MIDI files read into notes in seconds.
+//!
+//! Every track and channel is merged into one list. Metrical files follow the tempo map (set-tempo
+//! meta events from any track, 120 bpm until the first); SMPTE timecode files count fixed ticks per
+//! second. A note-on with velocity 0 is a note-off; each note-off ends the earliest note still held
+//! on its channel and key. Only notes are read: controllers, pitch bend and program changes are
+//! ignored.
+
+use std::collections::{HashMap, VecDeque};
+use std::path::Path;
+
+use midly::{MetaMessage, MidiMessage, Smf, Timing, TrackEventKind};
+
+use super::{Note, RenderError};
+
+/// Tempo until the first set-tempo event: 120 bpm, as the MIDI file specification says.
+const DEFAULT_MICROS_PER_QUARTER: u32 = 500_000;
+
+/// Largest MIDI velocity, which maps to velocity 1.
+const MAX_VELOCITY: f32 = 127.0;
+
+/// Reads the notes of the MIDI file at `path`, sorted by time.
+pub fn read_midi_file(path: impl AsRef<Path>) -> Result<Vec<Note>, RenderError> {
+    let path = path.as_ref();
+    let bytes = std::fs::read(path).map_err(|source| RenderError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let smf = Smf::parse(&bytes).map_err(|e| RenderError::Midi {
+        path: path.to_path_buf(),
+        message: format!("not a readable MIDI file: {e}"),
+    })?;
+    Ok(notes_of(&smf))
+}
+
+/// A note or tempo event at an absolute tick.
+#[derive(Debug, Clone, Copy)]
+enum Event {
+    /// Set-tempo meta event.
+    Tempo { micros_per_quarter: u32 },
+    /// Note-on with a velocity above 0.
+    On { channel: u8, key: u8, velocity: u8 },
+    /// Note-off, or note-on with velocity 0.
+    Off { channel: u8, key: u8 },
+}
+
+/// The notes of a parsed file, sorted by time.
+fn notes_of(smf: &Smf) -> Vec<Note> {
+    let mut events = Vec::new();
+    for track in &smf.tracks {
+        let mut tick = 0u64;
+        for event in track {
+            tick += event.delta.as_int() as u64;
+            let e = match event.kind {
+                TrackEventKind::Meta(MetaMessage::Tempo(t)) => Event::Tempo {
+                    micros_per_quarter: t.as_int(),
+                },
+                TrackEventKind::Midi { channel, message } => {
+                    let channel = channel.as_int();
+                    match message {
+                        MidiMessage::NoteOn { key, vel } if vel > 0 => Event::On {
+                            channel,
+                            key: key.as_int(),
+                            velocity: vel.as_int(),
+                        },
+                        MidiMessage::NoteOn { key, .. } | MidiMessage::NoteOff { key, .. } => {
+                            Event::Off {
+                                channel,
+                                key: key.as_int(),
+                            }
+                        }
+                        _ => continue,
+                    }
+                }
+                _ => continue,
+            };
+            events.push((tick, e));
+        }
+    }
+    // Stable: events at one tick keep their track order; tempo changes act before notes there.
+    events.sort_by_key(|&(tick, e)| (tick, !matches!(e, Event::Tempo { .. })));
+
+    let mut clock = Clock::new(smf.header.timing);
+    let mut notes: Vec<Note> = Vec::new();
+    let mut held: HashMap<(u8, u8), VecDeque<usize>> = HashMap::new();
+    for (tick, e) in events {
+        let time_s = clock.seconds_at(tick);
+        match e {
+            Event::Tempo { micros_per_quarter } => clock.set_tempo(tick, micros_per_quarter),
+            Event::On {
+                channel,
+                key,
+                velocity,
+            } => {
+                held.entry((channel, key))
+                    .or_default()
+                    .push_back(notes.len());
+                notes.push(Note {
+                    key,
+                    velocity: velocity as f32 / MAX_VELOCITY,
+                    time_s,
+                    duration_s: None,
+                });
+            }
+            Event::Off { channel, key } => {
+                if let Some(i) = held.get_mut(&(channel, key)).and_then(VecDeque::pop_front) {
+                    notes[i].duration_s = Some(time_s - notes[i].time_s);
+                }
+            }
+        }
+    }
+    notes
+}
+
+/// Converts absolute ticks to seconds, following tempo changes in tick order.
+struct Clock {
+    /// Seconds per tick for SMPTE timecode files, which ignore tempo.
+    fixed_s_per_tick: Option<f64>,
+    /// Ticks per quarter note, for metrical files.
+    ticks_per_quarter: f64,
+    /// Tick of the last tempo change.
+    anchor_tick: u64,
+    /// Time of the last tempo change, in seconds.
+    anchor_s: f64,
+    /// Seconds per tick since the last tempo change.
+    s_per_tick: f64,
+}
+
+impl Clock {
+    fn new(timing: Timing) -> Self {
+        let (fixed, ticks_per_quarter) = match timing {
+            Timing::Metrical(tpq) => (None, tpq.as_int().max(1) as f64),
+            Timing::Timecode(fps, ticks_per_frame) => (
+                Some(1.0 / (fps.as_f32() as f64 * ticks_per_frame.max(1) as f64)),
+                1.0,
+            ),
+        };
+        let mut clock = Self {
+            fixed_s_per_tick: fixed,
+            ticks_per_quarter,
+            anchor_tick: 0,
+            anchor_s: 0.0,
+            s_per_tick: 0.0,
+        };
+        clock.set_tempo(0, DEFAULT_MICROS_PER_QUARTER);
+        clock
+    }
+
+    /// Seconds at `tick`, which must not precede the last tempo change.
+    fn seconds_at(&self, tick: u64) -> f64 {
+        self.anchor_s + (tick - self.anchor_tick) as f64 * self.s_per_tick
+    }
+
+    /// A new tempo from `tick` on.
+    fn set_tempo(&mut self, tick: u64, micros_per_quarter: u32) {
+        self.anchor_s = self.seconds_at(tick);
+        self.anchor_tick = tick;
+        self.s_per_tick = self
+            .fixed_s_per_tick
+            .unwrap_or(micros_per_quarter as f64 * 1e-6 / self.ticks_per_quarter);
+    }
+}

@@ -1,0 +1,145 @@
+//! Stereo WAV files, written atomically.
+
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::Path;
+
+use hound::{SampleFormat, WavSpec, WavWriter};
+
+use super::{RenderError, Rendered};
+
+/// Permission bits of a new WAV file before the umask, as for any file a program creates.
+#[cfg(unix)]
+const NEW_FILE_MODE: u32 = 0o666;
+
+/// Sample format of a WAV file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BitDepth {
+    /// 16-bit integers.
+    Int16,
+    /// 24-bit integers.
+    #[default]
+    Int24,
+    /// 32-bit IEEE floats, unclipped.
+    Float32,
+}
+
+impl BitDepth {
+    /// Every depth.
+    pub const ALL: [BitDepth; 3] = [BitDepth::Int16, BitDepth::Int24, BitDepth::Float32];
+
+    /// Bits per sample.
+    pub fn bits(self) -> u16 {
+        match self {
+            BitDepth::Int16 => 16,
+            BitDepth::Int24 => 24,
+            BitDepth::Float32 => 32,
+        }
+    }
+
+    /// The depth with `bits` bits per sample (16 and 24 are integers, 32 is float).
+    pub fn from_bits(bits: u16) -> Option<Self> {
+        Self::ALL.into_iter().find(|d| d.bits() == bits)
+    }
+
+    /// Short description, such as "24-bit" or "32-bit float".
+    pub fn name(self) -> &'static str {
+        match self {
+            BitDepth::Int16 => "16-bit",
+            BitDepth::Int24 => "24-bit",
+            BitDepth::Float32 => "32-bit float",
+        }
+    }
+}
+
+/// Converts a sample in -1..1 to a `bits`-bit integer: scaled by `2^(bits-1)` (so -1 maps to the
+/// most negative code), rounded to nearest, clipped to the range. Not a number maps to 0.
+pub fn to_int_sample(x: f32, bits: u16) -> i32 {
+    let full_scale = (1i64 << (bits - 1)) as f64;
+    let v = (x as f64 * full_scale).round();
+    if v.is_nan() {
+        0
+    } else {
+        v.clamp(-full_scale, full_scale - 1.0) as i32
+    }
+}
+
+/// Writes `rendered` as a stereo WAV file at `path` with `bit_depth` and a sample rate of
+/// `sample_rate_hz` (normally `rendered.sample_rate_hz`). Integer depths round and clip (see
+/// [`to_int_sample`]); floats are written as they are, non-finite values as 0.
+///
+/// Atomic: the file is written to a temporary file in the destination directory and renamed into
+/// place, so on any failure neither a partial file nor the temporary file is left behind, and an
+/// existing file at `path` is untouched.
+pub fn write_wav(
+    path: impl AsRef<Path>,
+    rendered: &Rendered,
+    bit_depth: BitDepth,
+    sample_rate_hz: u32,
+) -> Result<(), RenderError> {
+    let path = path.as_ref();
+    let io_error = |source| RenderError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let wav_error = |source| RenderError::Wav {
+        path: path.to_path_buf(),
+        source,
+    };
+    let dir = match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    };
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".modal-resonator-").suffix(".wav.tmp");
+    // The file a user asked for, not a private temporary: the usual permissions less the umask.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(NEW_FILE_MODE));
+    // Dropping `temp` on any early return deletes it.
+    let mut temp = builder.tempfile_in(dir).map_err(io_error)?;
+
+    let spec = WavSpec {
+        channels: 2,
+        sample_rate: sample_rate_hz,
+        bits_per_sample: bit_depth.bits(),
+        sample_format: match bit_depth {
+            BitDepth::Float32 => SampleFormat::Float,
+            _ => SampleFormat::Int,
+        },
+    };
+    let mut writer = WavWriter::new(BufWriter::new(temp.as_file_mut()), spec).map_err(wav_error)?;
+    write_samples(&mut writer, rendered, bit_depth).map_err(wav_error)?;
+    writer.finalize().map_err(wav_error)?;
+    temp.as_file().sync_all().map_err(io_error)?;
+    temp.persist(path).map_err(|e| io_error(e.error))?;
+    Ok(())
+}
+
+fn write_samples(
+    writer: &mut WavWriter<BufWriter<&mut File>>,
+    rendered: &Rendered,
+    bit_depth: BitDepth,
+) -> hound::Result<()> {
+    let frames = rendered.left.iter().zip(&rendered.right);
+    match bit_depth {
+        BitDepth::Float32 => {
+            for (&l, &r) in frames {
+                writer.write_sample(if l.is_finite() { l } else { 0.0 })?;
+                writer.write_sample(if r.is_finite() { r } else { 0.0 })?;
+            }
+        }
+        BitDepth::Int16 => {
+            for (&l, &r) in frames {
+                writer.write_sample(to_int_sample(l, 16) as i16)?;
+                writer.write_sample(to_int_sample(r, 16) as i16)?;
+            }
+        }
+        BitDepth::Int24 => {
+            for (&l, &r) in frames {
+                writer.write_sample(to_int_sample(l, 24))?;
+                writer.write_sample(to_int_sample(r, 24))?;
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,381 @@
+//! The `modal-resonator` command line, run as a user would.
+
+mod common;
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use midly::num::{u15, u28, u4, u7};
+use midly::{Format, Header, MetaMessage, MidiMessage, Smf, Timing, TrackEvent, TrackEventKind};
+
+/// Runs the binary in `dir` with `args`.
+fn run(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_modal-resonator"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn stdout(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// A temporary directory holding `bank.json`: two quickly decaying modes rooted at 440 Hz.
+fn dir_with_bank() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let mut bank = common::simple_bank(&[(440.0, 8.0, 1.0), (1210.0, 15.0, 0.4)]);
+    bank.root_hz = Some(440.0);
+    std::fs::write(
+        dir.path().join("bank.json"),
+        serde_json::to_string_pretty(&bank).unwrap(),
+    )
+    .unwrap();
+    dir
+}
+
+/// Names in `dir`, sorted.
+fn entries(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// Asserts that `out` failed with a message containing each of `expected` on stderr, and that
+/// `dir` holds only `bank.json` (and `extra`): no output and no temporary file.
+fn assert_failed_cleanly(out: &Output, expected: &[&str], dir: &Path, extra: &[&str]) {
+    assert!(
+        !out.status.success(),
+        "should fail; stdout: {}",
+        stdout(out)
+    );
+    let err = stderr(out);
+    for e in expected {
+        assert!(err.contains(e), "stderr should mention {e:?}: {err}");
+    }
+    let mut allowed: Vec<String> = ["bank.json"]
+        .iter()
+        .chain(extra)
+        .map(|s| s.to_string())
+        .collect();
+    allowed.sort();
+    assert_eq!(entries(dir), allowed, "files left in the directory");
+}
+
+#[test]
+fn renders_a_bank_file_to_a_wav() {
+    let dir = dir_with_bank();
+    let out = run(
+        dir.path(),
+        &[
+            "render",
+            "bank.json",
+            "--notes",
+            "69:1@0, 72:0.5@0.2+0.3",
+            "-o",
+            "out.wav",
+            "--bits",
+            "16",
+            "--rate",
+            "44100",
+            "--set",
+            "material=wood",
+            "--set",
+            "width=0.8",
+        ],
+    );
+    assert!(out.status.success(), "stderr: {}", stderr(&out));
+    let summary = stdout(&out);
+    assert!(
+        summary.contains("out.wav") && summary.contains("dBFS"),
+        "summary: {summary}"
+    );
+    assert_eq!(entries(dir.path()), ["bank.json", "out.wav"]);
+
+    let mut reader = hound::WavReader::open(dir.path().join("out.wav")).unwrap();
+    let spec = reader.spec();
+    assert_eq!(
+        (spec.channels, spec.sample_rate, spec.bits_per_sample),
+        (2, 44_100, 16)
+    );
+    assert_eq!(spec.sample_format, hound::SampleFormat::Int);
+    let samples: Vec<i16> = reader.samples::<i16>().map(Result::unwrap).collect();
+    assert!(samples.len() > 2 * 44_100 / 5, "{} samples", samples.len());
+    let peak = samples.iter().map(|s| s.unsigned_abs()).max().unwrap();
+    assert!(peak > 3000, "peak {peak} of 32768: should be audible");
+}
+
+#[test]
+fn renders_a_midi_file() {
+    let dir = dir_with_bank();
+    let on = |delta: u32, vel: u8| TrackEvent {
+        delta: u28::new(delta),
+        kind: TrackEventKind::Midi {
+            channel: u4::new(0),
+            message: MidiMessage::NoteOn {
+                key: u7::new(69),
+                vel: u7::new(vel),
+            },
+        },
+    };
+    let smf = Smf {
+        header: Header::new(Format::SingleTrack, Timing::Metrical(u15::new(96))),
+        tracks: vec![vec![
+            on(0, 100),
+            on(48, 0),
+            TrackEvent {
+                delta: u28::new(0),
+                kind: TrackEventKind::Meta(MetaMessage::EndOfTrack),
+            },
+        ]],
+    };
+    smf.save(dir.path().join("song.mid")).unwrap();
+    let out = run(
+        dir.path(),
+        &[
+            "render",
+            "bank.json",
+            "--midi",
+            "song.mid",
+            "-o",
+            "song.wav",
+            "--bits",
+            "32",
+        ],
+    );
+    assert!(out.status.success(), "stderr: {}", stderr(&out));
+    let mut reader = hound::WavReader::open(dir.path().join("song.wav")).unwrap();
+    assert_eq!(reader.spec().sample_format, hound::SampleFormat::Float);
+    let peak = reader
+        .samples::<f32>()
+        .map(Result::unwrap)
+        .fold(0.0f32, |a, s| a.max(s.abs()));
+    assert!(peak > 0.1, "peak {peak}");
+}
+
+#[test]
+fn identical_runs_write_identical_files() {
+    let dir = dir_with_bank();
+    let args = |out: &'static str| {
+        [
+            "render",
+            "bank.json",
+            "--notes",
+            "60:1@0, 67:0.7@0.1, 64:0.4@0.15+0.1",
+            "-o",
+            out,
+            "--set",
+            "position_variation=0.4",
+        ]
+    };
+    for name in ["a.wav", "b.wav"] {
+        let out = run(dir.path(), &args(name));
+        assert!(out.status.success(), "stderr: {}", stderr(&out));
+    }
+    let a = std::fs::read(dir.path().join("a.wav")).unwrap();
+    let b = std::fs::read(dir.path().join("b.wav")).unwrap();
+    assert!(a.len() > 1000);
+    assert!(
+        a == b,
+        "two runs with the same arguments wrote different files"
+    );
+}
+
+#[test]
+fn a_bad_bank_file_fails_and_writes_nothing() {
+    let dir = dir_with_bank();
+    std::fs::write(
+        dir.path().join("broken.json"),
+        "{ \"format\": \"modal-bank\", ",
+    )
+    .unwrap();
+    let out = run(
+        dir.path(),
+        &[
+            "render",
+            "broken.json",
+            "--notes",
+            "60:1@0",
+            "-o",
+            "out.wav",
+        ],
+    );
+    assert_failed_cleanly(
+        &out,
+        &["broken.json", "not a valid bank"],
+        dir.path(),
+        &["broken.json"],
+    );
+
+    std::fs::write(dir.path().join("wrong.json"), "{ \"modes\": 3 }").unwrap();
+    let out = run(
+        dir.path(),
+        &["render", "wrong.json", "--notes", "60:1@0", "-o", "out.wav"],
+    );
+    assert_failed_cleanly(
+        &out,
+        &["wrong.json"],
+        dir.path(),
+        &["broken.json", "wrong.json"],
+    );
+
+    let out = run(
+        dir.path(),
+        &[
+            "render",
+            "no-such-bank",
+            "--notes",
+            "60:1@0",
+            "-o",
+            "out.wav",
+        ],
+    );
+    assert_failed_cleanly(
+        &out,
+        &["no bank file or factory preset named \"no-such-bank\""],
+        dir.path(),
+        &["broken.json", "wrong.json"],
+    );
+}
+
+#[test]
+fn bad_notes_fail_and_write_nothing() {
+    let dir = dir_with_bank();
+    let out = run(
+        dir.path(),
+        &[
+            "render",
+            "bank.json",
+            "--notes",
+            "60:1@0, 61:1.5@0.1",
+            "-o",
+            "out.wav",
+        ],
+    );
+    assert_failed_cleanly(&out, &["--notes", "note 2", "velocity"], dir.path(), &[]);
+    let out = run(
+        dir.path(),
+        &["render", "bank.json", "--notes", "200:1@0", "-o", "out.wav"],
+    );
+    assert_failed_cleanly(&out, &["key", "0 to 127"], dir.path(), &[]);
+    let out = run(
+        dir.path(),
+        &[
+            "render",
+            "bank.json",
+            "--midi",
+            "missing.mid",
+            "-o",
+            "out.wav",
+        ],
+    );
+    assert_failed_cleanly(&out, &["missing.mid"], dir.path(), &[]);
+    // Neither notes nor a MIDI file.
+    let out = run(dir.path(), &["render", "bank.json", "-o", "out.wav"]);
+    assert_failed_cleanly(&out, &["--notes", "--midi"], dir.path(), &[]);
+}
+
+#[test]
+fn bad_controls_fail_and_write_nothing() {
+    let dir = dir_with_bank();
+    let render_with = |set: &str| {
+        run(
+            dir.path(),
+            &[
+                "render",
+                "bank.json",
+                "--notes",
+                "60:1@0",
+                "-o",
+                "out.wav",
+                "--set",
+                set,
+            ],
+        )
+    };
+    let out = render_with("sise_ratio=2");
+    assert_failed_cleanly(&out, &["sise_ratio", "unknown control"], dir.path(), &[]);
+    let out = render_with("size_ratio=9");
+    assert_failed_cleanly(&out, &["size_ratio", "0.25 to 4"], dir.path(), &[]);
+    let out = render_with("material=cheese");
+    assert_failed_cleanly(&out, &["material", "cheese"], dir.path(), &[]);
+    let out = render_with("size_ratio");
+    assert_failed_cleanly(&out, &["NAME=VALUE"], dir.path(), &[]);
+    let out = run(
+        dir.path(),
+        &[
+            "render",
+            "bank.json",
+            "--notes",
+            "60:1@0",
+            "-o",
+            "out.wav",
+            "--bits",
+            "20",
+        ],
+    );
+    assert_failed_cleanly(&out, &["--bits", "16, 24 or 32"], dir.path(), &[]);
+}
+
+#[test]
+fn an_unwritable_output_fails_and_leaves_nothing() {
+    let dir = dir_with_bank();
+    let out = run(
+        dir.path(),
+        &[
+            "render",
+            "bank.json",
+            "--notes",
+            "60:1@0",
+            "-o",
+            "missing/out.wav",
+        ],
+    );
+    assert_failed_cleanly(
+        &out,
+        &["missing/out.wav", "does not exist"],
+        dir.path(),
+        &[],
+    );
+
+    std::fs::create_dir(dir.path().join("sub")).unwrap();
+    let out = run(
+        dir.path(),
+        &["render", "bank.json", "--notes", "60:1@0", "-o", "sub"],
+    );
+    assert_failed_cleanly(&out, &["sub", "is a directory"], dir.path(), &["sub"]);
+    assert!(entries(&dir.path().join("sub")).is_empty());
+
+    // Passes the early checks; fails when the finished file is renamed into place.
+    let out = run(
+        dir.path(),
+        &[
+            "render",
+            "bank.json",
+            "--notes",
+            "60:1@0",
+            "-o",
+            "late.wav/",
+        ],
+    );
+    assert_failed_cleanly(&out, &["late.wav"], dir.path(), &["sub"]);
+}
+
+#[test]
+fn no_subcommand_prints_help() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = run(dir.path(), &[]);
+    assert!(out.status.success(), "stderr: {}", stderr(&out));
+    let help = stdout(&out);
+    assert!(
+        help.contains("Usage") && help.contains("render"),
+        "help: {help}"
+    );
+}
