@@ -1,4 +1,4 @@
-//! The `modal-resonator` command: renders banks offline (and, later, inspects and validates them).
+//! The `modal-resonator` command: renders banks offline, inspects and validates them.
 //! Thin over the library: every decision about sound lives in `modal_resonator`.
 
 use std::io::IsTerminal;
@@ -11,7 +11,10 @@ use clap::{Args, CommandFactory, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use modal_resonator::engine::{Controls, PreparedBank};
-use modal_resonator::model::Bank;
+use modal_resonator::model::factory::{factory_bank, factory_banks, factory_slug};
+use modal_resonator::model::schema::bank_schema_json;
+use modal_resonator::model::summary::BankSummary;
+use modal_resonator::model::{load_bank_file, Bank};
 use modal_resonator::render::{
     parse_notes, read_midi_file, render, write_wav, BitDepth, Note, RenderSettings,
 };
@@ -36,8 +39,21 @@ struct Cli {
 enum Command {
     /// Render notes or a MIDI file through a bank to a stereo WAV file.
     Render(RenderArgs),
-    // To come: `info FILE` (describe a bank) and `validate FILE...` (check banks against the
-    // format), each a variant here with its own `Args` struct and a `run_*` function below.
+    /// Check bank files and print every problem found.
+    Validate {
+        /// Bank files (JSON).
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+    },
+    /// Describe a bank: modes, positions, frequency range, T60s.
+    Info {
+        /// Bank file (JSON) or factory preset name.
+        bank: String,
+    },
+    /// List the factory banks.
+    List,
+    /// Print the JSON Schema of the bank format.
+    Schema,
 }
 
 /// Arguments of `render`.
@@ -73,6 +89,23 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Some(Command::Render(args)) => run_render(&args),
+        Some(Command::Validate { files }) => run_validate(&files),
+        Some(Command::Info { bank }) => load_bank(&bank).map(|b| print!("{}", BankSummary::of(&b))),
+        Some(Command::List) => {
+            for bank in factory_banks() {
+                println!(
+                    "{:<28} {:>5} modes  {}",
+                    factory_slug(&bank),
+                    bank.modes.len(),
+                    bank.name
+                );
+            }
+            Ok(())
+        }
+        Some(Command::Schema) => {
+            print!("{}", bank_schema_json());
+            Ok(())
+        }
         None => Cli::command().print_help().map_err(|e| e.to_string()),
     };
     match result {
@@ -84,16 +117,43 @@ fn main() -> ExitCode {
     }
 }
 
-/// Loads the bank named on the command line: a bank file if `arg` is a path that exists.
-///
-/// Factory presets and full validation are not wired in yet: this is the one place to do it.
+/// Loads the bank named on the command line: a bank file (validated) if `arg` is a path that
+/// exists, else the factory bank of that name or slug.
 fn load_bank(arg: &str) -> Result<Bank, String> {
     let path = Path::new(arg);
-    if !path.exists() {
-        return Err(format!("no bank file or factory preset named \"{arg}\""));
+    if path.exists() {
+        return load_bank_file(path).map_err(|e| e.to_string());
     }
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{arg}: {e}"))?;
-    serde_json::from_str::<Bank>(&text).map_err(|e| format!("{arg}: not a valid bank: {e}"))
+    factory_bank(arg).ok_or_else(|| {
+        let names: Vec<String> = factory_banks().iter().map(factory_slug).collect();
+        format!(
+            "no bank file or factory preset named \"{arg}\"; factory presets: {}",
+            names.join(", ")
+        )
+    })
+}
+
+/// `validate`: every problem of every file; fails if any file has one.
+fn run_validate(files: &[PathBuf]) -> Result<(), String> {
+    let mut bad = 0;
+    for path in files {
+        match load_bank_file(path) {
+            Ok(bank) => println!(
+                "{}: ok ({} modes, {} positions)",
+                path.display(),
+                bank.modes.len(),
+                bank.positions.len()
+            ),
+            Err(e) => {
+                bad += 1;
+                println!("{e}");
+            }
+        }
+    }
+    match bad {
+        0 => Ok(()),
+        n => Err(format!("{n} of {} files have problems", files.len())),
+    }
 }
 
 /// `render`: everything is checked before rendering, and nothing is written on failure.

@@ -209,7 +209,7 @@ fn a_bad_bank_file_fails_and_writes_nothing() {
     );
     assert_failed_cleanly(
         &out,
-        &["broken.json", "not a valid bank"],
+        &["broken.json:1:", "truncated"],
         dir.path(),
         &["broken.json"],
     );
@@ -378,4 +378,101 @@ fn no_subcommand_prints_help() {
         help.contains("Usage") && help.contains("render"),
         "help: {help}"
     );
+}
+
+/// The broken banks of the format tests, each with the JSON path (or position) its error names.
+const BROKEN: &[(&str, &str)] = &[
+    ("coords-3d.json", "positions[0].coords"),
+    ("duplicate-position-names.json", "positions[2].name"),
+    ("huge-number-1e300.json", "modes[0].freq_hz"),
+    ("huge-number-1e400.json", "out of range"),
+    ("nan-literal.json", "NaN"),
+    ("negative-frequency.json", "modes[1].freq_hz"),
+    ("no-modes.json", "modes: found 0 modes"),
+    ("ragged-gains.json", "modes[3].gains"),
+    ("truncated.json", "truncated"),
+    ("unknown-field.json", "did you mean \"freq_hz\""),
+    ("version-2.json", "newer version"),
+    ("wrong-types.json", "expected a string"),
+];
+
+#[test]
+fn every_broken_bank_fails_to_render_and_writes_nothing() {
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/bad");
+    for (file, expected) in BROKEN {
+        let dir = dir_with_bank();
+        std::fs::copy(fixtures.join(file), dir.path().join(file)).unwrap();
+        let out = run(
+            dir.path(),
+            &["render", file, "--notes", "60:1@0", "-o", "out.wav"],
+        );
+        assert_failed_cleanly(&out, &[file, expected], dir.path(), &[file]);
+    }
+}
+
+#[test]
+fn validate_reports_every_problem_and_fails_on_any() {
+    let dir = dir_with_bank();
+    let fixtures = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/bad");
+    std::fs::copy(
+        fixtures.join("many-problems.json"),
+        dir.path().join("many.json"),
+    )
+    .unwrap();
+    let good = run(dir.path(), &["validate", "bank.json"]);
+    assert!(good.status.success(), "{}", stderr(&good));
+    assert!(
+        stdout(&good).contains("bank.json: ok (2 modes, 1 positions)"),
+        "{}",
+        stdout(&good)
+    );
+    let bad = run(dir.path(), &["validate", "bank.json", "many.json"]);
+    assert!(!bad.status.success());
+    let text = stdout(&bad);
+    for path in [
+        "root_hz",
+        "positions[1].weight",
+        "modes[0].decay_per_s",
+        "modes[1].gains",
+        "defaults.hardness_ms",
+    ] {
+        assert!(
+            text.contains(&format!("many.json: {path}")),
+            "missing {path}: {text}"
+        );
+    }
+    assert!(stderr(&bad).contains("1 of 2 files have problems"));
+}
+
+#[test]
+fn factory_presets_render_and_describe_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = run(
+        dir.path(),
+        &[
+            "render",
+            "steel-free-free-bar",
+            "--notes",
+            "84:0.9@0",
+            "-o",
+            "bar.wav",
+            "--max-seconds",
+            "2",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let reader = hound::WavReader::open(dir.path().join("bar.wav")).unwrap();
+    assert_eq!(reader.spec().channels, 2);
+    let info = run(dir.path(), &["info", "Bronze bell"]);
+    assert!(info.status.success(), "{}", stderr(&info));
+    let text = stdout(&info);
+    assert!(
+        text.contains("root: 440.00 Hz (A4)") && text.contains("modes: 11"),
+        "{text}"
+    );
+    let list = run(dir.path(), &["list"]);
+    assert!(stdout(&list).lines().count() >= 6);
+    let schema = run(dir.path(), &["schema"]);
+    let parsed: serde_json::Value = serde_json::from_slice(&schema.stdout).unwrap();
+    assert!(parsed.get("properties").is_some());
 }

@@ -312,28 +312,6 @@ fn value_difference(
     }
 }
 
-/// Name of the equal-tempered note nearest `freq_hz` and its offset in cents, e.g. "C4" or
-/// "C4 +12 c".
-fn note_name(freq_hz: f64) -> String {
-    const NAMES: [&str; 12] = [
-        "C", "C#", "D", "D#", "E", "F", "F#", "G", "G#", "A", "A#", "B",
-    ];
-    let key = 69.0 + 12.0 * (freq_hz / 440.0).log2();
-    let nearest = key.round();
-    let cents = ((key - nearest) * 100.0).round();
-    let index = nearest as i64;
-    let name = format!(
-        "{}{}",
-        NAMES[index.rem_euclid(12) as usize],
-        index.div_euclid(12) - 1
-    );
-    if cents == 0.0 {
-        name
-    } else {
-        format!("{name} {cents:+} c")
-    }
-}
-
 /// The Markdown table of the factory banks, kept in `presets/README.md`.
 pub fn factory_table_markdown(banks: &[Bank]) -> String {
     let mut text = String::from(
@@ -362,7 +340,7 @@ pub fn factory_table_markdown(banks: &[Bank]) -> String {
             field("shape"),
             field("material"),
             root_hz,
-            note_name(root_hz),
+            crate::model::summary::note_name(root_hz),
             bank.modes.len(),
             positions.join(", "),
         ));

@@ -8,6 +8,7 @@ pub mod io;
 pub mod materials;
 pub mod schema;
 pub mod shapes;
+pub mod summary;
 pub mod validate;
 
 pub use bank::{Bank, BankDefaults, Mode, Position};
