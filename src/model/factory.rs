@@ -351,6 +351,7 @@ pub fn factory_table_markdown(banks: &[Bank]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::summary::note_name;
     use std::collections::HashSet;
 
     #[test]
