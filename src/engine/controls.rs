@@ -1,6 +1,7 @@
 //! The engine's controls: plain values in natural units, with their ranges, defaults and names in
 //! one table shared by the plugin's parameters, the command line and the tests.
 
+use super::position::PositionMap;
 use crate::dsp::ExciterKind;
 use crate::model::Bank;
 
@@ -205,9 +206,15 @@ pub const NUMERIC_CONTROLS: &[ControlSpec] = &[
 pub const MATERIAL_Q_RANGE: (f32, f32) = (1.0, 100_000.0);
 
 impl Controls {
-    /// The defaults, with the bank's own `defaults` applied.
+    /// The defaults for `bank`: struck at its first position, with the bank's own `defaults`
+    /// applied on top.
     pub fn for_bank(bank: &Bank) -> Self {
         let mut c = Self::default();
+        let coords: Vec<Vec<f64>> = bank.positions.iter().map(|p| p.coords.clone()).collect();
+        if let Some(first) = PositionMap::new(&coords).coords().first() {
+            c.strike_x = first[0] as f32;
+            c.strike_y = first[1] as f32;
+        }
         if let Some(d) = &bank.defaults {
             if let Some(q) = d.material_q {
                 c.material_q = Some(q as f32);

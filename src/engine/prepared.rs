@@ -10,7 +10,8 @@ use crate::dsp::coeffs::{hz_to_midi_key, ModeCoeffs, MIN_DECAY_PER_S};
 use crate::dsp::{Exciter, Kernel, ResonatorBank, COLUMNS};
 use crate::model::Bank;
 
-/// Peak of a full-velocity mallet strike at the first position, at the bank's defaults: -6 dBFS.
+/// Peak of a full-velocity strike at the bank's defaults (struck at its first position unless
+/// the bank's defaults name another strike point): -6 dBFS.
 pub const TARGET_PEAK: f32 = 0.5;
 
 /// Sample rate of the loudness measurement; level does not depend on the rate.
@@ -115,13 +116,14 @@ impl PreparedBank {
             .max(MIN_DECAY_PER_S)
     }
 
-    /// Peak of a full-velocity mallet strike at the first position with the bank's default
-    /// controls at the root pitch, before normalisation.
+    /// Peak of a full-velocity strike with the bank's default controls (struck at its first
+    /// position unless its defaults name another strike point) at the root pitch, before
+    /// normalisation.
     fn measure_default_peak(&self) -> f32 {
         let controls = Controls::for_bank(&self.source);
         let n = self.num_modes();
         let mut bank = ResonatorBank::new(n);
-        let w = PositionWeights::single(0);
+        let w = self.positions.weights(controls.strike_x, controls.strike_y);
         let theta_max = TAU * crate::dsp::coeffs::MAX_FREQ_RATIO;
         let log_damping = self.log_damping(controls.material_q);
         for m in 0..n {
