@@ -299,7 +299,10 @@ impl Engine {
 
     /// The keys of the voices sounding now (held or ringing after release), in voice order.
     pub fn sounding_keys(&self) -> impl Iterator<Item = u8> + '_ {
-        self.voices.iter().filter(|v| v.is_sounding()).map(|v| v.key)
+        self.voices
+            .iter()
+            .filter(|v| v.is_sounding())
+            .map(|v| v.key)
     }
 
     /// Whether nothing sounds and nothing is about to.

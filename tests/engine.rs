@@ -168,7 +168,11 @@ fn voices_are_stolen_quietest_first_with_a_fade() {
     assert_eq!(e.stats().voices, 2);
     let mut keys: Vec<u8> = e.sounding_keys().collect();
     keys.sort();
-    assert_eq!(keys, [55, 60], "the soft first note is the quietest and must be the one stolen");
+    assert_eq!(
+        keys,
+        [55, 60],
+        "the soft first note is the quietest and must be the one stolen"
+    );
     let steady = max_step(&l[2_100..3_900]);
     let steal = max_step(&l[3_990..4_400]);
     assert!(

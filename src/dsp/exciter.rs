@@ -121,10 +121,10 @@ impl Exciter {
         } else {
             len_samples.max(1)
         };
-        // Linear envelope (1 - n/len): sum of squares ~ len / 3; uniform noise has variance 1/3.
-        let env_energy: f32 = (0..len)
-            .map(|n| (1.0 - n as f32 / len as f32).powi(2))
-            .sum();
+        // Linear envelope (1 - n/len) for n = 0..len: its squares sum to (len + 1)(2 len + 1) /
+        // (6 len). Uniform noise has variance 1/3.
+        let l = len as f32;
+        let env_energy = (l + 1.0) * (2.0 * l + 1.0) / (6.0 * l);
         let noise_scale = (3.0 / env_energy.max(1e-9)).sqrt();
         let pulse = Pulse {
             kind,
