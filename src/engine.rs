@@ -29,7 +29,7 @@ pub use prepared::{PreparedBank, TARGET_PEAK};
 use stereo::lane_weights;
 use voice::{Tuning, Voice, VoiceState};
 
-use crate::dsp::coeffs::{db_to_gain, t60_to_decay};
+use crate::dsp::coeffs::{db_to_gain, t60_to_decay, MIN_DECAY_PER_S};
 use crate::dsp::denormal::FlushDenormals;
 use crate::dsp::rng::Rng;
 use crate::dsp::{Kernel, COLUMNS};
@@ -80,6 +80,17 @@ impl NoteEvent {
     }
 }
 
+/// How far the decay table lags the smoothed material.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Stale {
+    /// Up to date.
+    Fresh,
+    /// Q moved: rescale the tilted decays.
+    Damping,
+    /// Tilt moved (or a new bank): recompute the tilted decays too.
+    Tilt,
+}
+
 /// What the engine is doing, for meters.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct EngineStats {
@@ -126,8 +137,14 @@ pub struct Engine {
     input_voice: Option<Voice>,
     /// Whether the input voice has had non-silent input since the last control tick.
     input_heard: bool,
+    /// Whether the input voice has lost modes to truncation since input last started them.
+    input_dormant: bool,
+    /// Decay rate of each mode with the smoothed damping tilt applied, before Q and pitch.
+    tilted_decay: Vec<f64>,
     /// Damped decay rate of each mode at the smoothed material, before pitch scaling.
     decay: Vec<f64>,
+    /// How far `decay` lags the smoothed material.
+    decay_stale: Stale,
     /// Incremented whenever `decay` changes.
     damping_version: u64,
     /// Smoothed controls.
@@ -170,7 +187,10 @@ impl Engine {
             voices: Vec::new(),
             input_voice: None,
             input_heard: false,
+            input_dormant: true,
+            tilted_decay: Vec::new(),
             decay: Vec::new(),
+            decay_stale: Stale::Tilt,
             damping_version: 0,
             smoothed,
             clock: 0,
@@ -214,6 +234,9 @@ impl Engine {
             }
         }
         self.decay.resize(self.bank.num_modes(), 0.0);
+        self.tilted_decay.resize(self.bank.num_modes(), 0.0);
+        self.input_dormant = true;
+        self.decay_stale = Stale::Tilt;
         self.rebuild_decay_table();
     }
 
@@ -224,6 +247,7 @@ impl Engine {
             .collect();
         self.input_voice = Some(Voice::new(n, SEED ^ 0xFFFF));
         self.decay = vec![0.0; n];
+        self.tilted_decay = vec![0.0; n];
     }
 
     /// Silences every voice and restarts smoothing and random sequences. Does not allocate.
@@ -235,6 +259,7 @@ impl Engine {
         self.allocations = 0;
         self.last_key = None;
         self.input_heard = false;
+        self.input_dormant = true;
         self.rng = Rng::new(SEED);
         let (log_damping, tilt) = self.damping_targets();
         self.smoothed = Smoothed {
@@ -246,6 +271,7 @@ impl Engine {
             weight_step: ([0.0; COLUMNS], [0.0; COLUMNS]),
             weight_ramp_left: 0,
         };
+        self.decay_stale = Stale::Tilt;
         self.rebuild_decay_table();
     }
 

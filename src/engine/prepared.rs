@@ -1,7 +1,7 @@
 //! A bank made ready for the audio thread: modes sorted by frequency, tables in the units the
 //! voices use, and the level that meets the loudness contract.
 
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::TAU;
 
 use super::controls::Controls;
 use super::position::{PositionMap, PositionWeights};
@@ -10,8 +10,8 @@ use crate::dsp::coeffs::{hz_to_midi_key, ModeCoeffs, MIN_DECAY_PER_S};
 use crate::dsp::{Exciter, Kernel, ResonatorBank, COLUMNS};
 use crate::model::Bank;
 
-/// Peak of a full-velocity strike at the bank's defaults (struck at its first position unless
-/// the bank's defaults name another strike point): -6 dBFS.
+/// Peak of a full-velocity strike at the bank's first position, with its default controls:
+/// -6 dBFS.
 pub const TARGET_PEAK: f32 = 0.5;
 
 /// Sample rate of the loudness measurement; level does not depend on the rate.
@@ -62,13 +62,7 @@ impl PreparedBank {
             .iter()
             .map(|&m| bank.modes[m].decay_per_s.max(MIN_DECAY_PER_S))
             .collect();
-        let mut qs: Vec<f64> = freq_hz
-            .iter()
-            .zip(&decay_per_s)
-            .map(|(f, d)| PI * f / d)
-            .collect();
-        qs.sort_by(f64::total_cmp);
-        let reference_q = qs.get(qs.len() / 2).copied().unwrap_or(1.0);
+        let reference_q = bank.reference_q().unwrap_or(1.0);
         let mut prepared = Self {
             source: bank.clone(),
             decay_per_s,
@@ -116,14 +110,13 @@ impl PreparedBank {
             .max(MIN_DECAY_PER_S)
     }
 
-    /// Peak of a full-velocity strike with the bank's default controls (struck at its first
-    /// position unless its defaults name another strike point) at the root pitch, before
-    /// normalisation.
+    /// Peak of a full-velocity strike at the first position with the bank's other default
+    /// controls (material, exciter, hardness, width) at the root pitch, before normalisation.
     fn measure_default_peak(&self) -> f32 {
         let controls = Controls::for_bank(&self.source);
         let n = self.num_modes();
         let mut bank = ResonatorBank::new(n);
-        let w = self.positions.weights(controls.strike_x, controls.strike_y);
+        let w = PositionWeights::single(0);
         let theta_max = TAU * crate::dsp::coeffs::MAX_FREQ_RATIO;
         let log_damping = self.log_damping(controls.material_q);
         for m in 0..n {
@@ -149,7 +142,7 @@ impl PreparedBank {
         const RUN: usize = 256;
         let mut acc = vec![[0.0f32; COLUMNS]; RUN];
         let mut input = vec![0.0f32; RUN];
-        let kernel = Kernel::detect();
+        let kernel = Kernel::from_env_or_detect();
         let mut peak = 0.0f32;
         for _ in 0..total.div_ceil(RUN) {
             for a in acc.iter_mut() {

@@ -1,6 +1,7 @@
 //! The audio-thread half of the engine: events, control ticks and rendering.
 
 use super::*;
+use crate::dsp::ExciterKind;
 
 impl Engine {
     /// Renders `out_l.len()` samples into `out_l` and `out_r` (overwritten), applying `events`
@@ -60,11 +61,20 @@ impl Engine {
         )
     }
 
+    /// Brings the decay table up to the smoothed material: a tilt change costs an `exp` per
+    /// mode, a Q change only a multiply.
     pub(super) fn rebuild_decay_table(&mut self) {
         let (log_damping, tilt) = (self.smoothed.log_damping, self.smoothed.tilt);
-        for (m, d) in self.decay.iter_mut().enumerate() {
-            *d = self.bank.damped_decay(m, log_damping, tilt);
+        if self.decay_stale == Stale::Tilt {
+            for (m, d) in self.tilted_decay.iter_mut().enumerate() {
+                *d = self.bank.damped_decay(m, 0.0, tilt);
+            }
         }
+        let scale = log_damping.exp();
+        for (d, t) in self.decay.iter_mut().zip(&self.tilted_decay) {
+            *d = (t * scale).max(MIN_DECAY_PER_S);
+        }
+        self.decay_stale = Stale::Fresh;
         self.damping_version += 1;
     }
 
@@ -91,8 +101,17 @@ impl Engine {
         let k = self.tick_coefficient(DAMPING_SMOOTHING_S);
         let s = &mut self.smoothed;
         if s.log_damping != target_damping || s.tilt != target_tilt {
+            let tilt_moved = s.tilt != target_tilt;
             s.log_damping = step_towards(s.log_damping, target_damping, k, 1e-4);
             s.tilt = step_towards(s.tilt, target_tilt, k, 1e-4);
+            self.decay_stale = self.decay_stale.max(if tilt_moved {
+                Stale::Tilt
+            } else {
+                Stale::Damping
+            });
+        }
+        // Only sounding voices need the table now; a note-on brings it up to date otherwise.
+        if self.decay_stale != Stale::Fresh && !self.is_silent() {
             self.rebuild_decay_table();
         }
         // Stereo width: ramp the column weights over the next period.
@@ -129,7 +148,16 @@ impl Engine {
                 continue;
             }
             if v.exciter.is_idle() && !(is_input && input_heard) {
-                v.energy = v.modes.retire_below(threshold);
+                // Each mode gets an equal share of the threshold's energy, so all the modes
+                // retired at once drop less than the threshold (seed 000 section 5.4.2 applies
+                // the threshold to each mode alone, which lets hundreds of dropped modes add up).
+                let live = v.modes.num_live();
+                v.energy = v
+                    .modes
+                    .retire_below(threshold / (live.max(1) as f32).sqrt());
+                if is_input && v.modes.num_live() < live {
+                    self.input_dormant = true;
+                }
                 if v.modes.num_live() == 0 {
                     v.free();
                     continue;
@@ -190,9 +218,10 @@ impl Engine {
     }
 
     fn quietest_sounding(&self) -> usize {
+        // Energy now, not at the last tick: a voice struck since then must not look silent.
         let loudness = |v: &Voice| {
             if v.exciter.is_idle() {
-                v.energy
+                v.modes.energy()
             } else {
                 f32::INFINITY
             }
@@ -238,6 +267,9 @@ impl Engine {
     }
 
     fn note_on(&mut self, key: u8, velocity: f32) {
+        if self.decay_stale != Stale::Fresh {
+            self.rebuild_decay_table();
+        }
         let i = self.voice_for(key);
         let fresh = self.voices[i].state == VoiceState::Free;
         if fresh {
@@ -318,47 +350,16 @@ impl Engine {
                 v.modes.process(self.kernel, drive, acc);
             }
         }
-        if let (Some(input), Some(v)) = (input, self.input_voice.as_mut()) {
-            let gain = db_to_gain(self.controls.input_gain_db);
-            let mut heard = false;
-            for (xi, &s) in x.iter_mut().zip(input) {
-                *xi = if s.is_finite() { gain * s } else { 0.0 };
-                heard |= *xi != 0.0;
-            }
-            if heard {
-                self.input_heard = true;
-                if v.modes.num_live() == 0 {
-                    let weights = self
-                        .bank
-                        .positions
-                        .weights(self.controls.strike_x, self.controls.strike_y);
-                    let tuning = tuning_of(v, self.damping_version, 0.0);
-                    // Every mode in range; the strike itself adds nothing (amplitude 0).
-                    v.strike(
-                        &self.bank,
-                        &self.decay,
-                        self.sample_rate_hz,
-                        tuning,
-                        &weights,
-                        crate::dsp::ExciterKind::Impulse,
-                        0.0,
-                        1,
-                        0.0,
-                    );
-                    v.exciter.reset();
-                }
-                v.modes.process(self.kernel, Some(x), acc);
-            } else if v.modes.num_live() > 0 {
-                v.modes.process(self.kernel, None, acc);
-            }
-        } else if let Some(v) = self.input_voice.as_mut().filter(|v| v.modes.num_live() > 0) {
-            v.modes.process(self.kernel, None, acc);
-        }
+        self.drive_input_voice(input, n);
 
         let s = &mut self.smoothed;
         let target_gain = db_to_gain(self.controls.output_gain_db);
         let gain_k = (1.0 - (-1.0 / (GAIN_SMOOTHING_S * self.sample_rate_hz)).exp()) as f32;
-        for ((a, l), r) in acc.iter().zip(out_l.iter_mut()).zip(out_r.iter_mut()) {
+        for ((a, l), r) in self.acc[..n]
+            .iter()
+            .zip(out_l.iter_mut())
+            .zip(out_r.iter_mut())
+        {
             if s.weight_ramp_left > 0 {
                 s.weight_ramp_left -= 1;
                 for j in 0..COLUMNS {
@@ -377,6 +378,72 @@ impl Engine {
             }
             *l = sl * s.gain;
             *r = sr * s.gain;
+        }
+    }
+
+    /// Adds the input voice's output for the current run to `self.acc`, driven by `input`
+    /// (non-finite samples count as silence). Input after truncation has retired modes starts
+    /// every mode again, from where it is.
+    fn drive_input_voice(&mut self, input: Option<&[f32]>, n: usize) {
+        let Some(input) = input else {
+            if let Some(v) = self.input_voice.as_mut().filter(|v| v.modes.num_live() > 0) {
+                v.modes.process(self.kernel, None, &mut self.acc[..n]);
+            }
+            return;
+        };
+        let gain = db_to_gain(self.controls.input_gain_db);
+        let x = &mut self.excitation[..n];
+        let mut heard = false;
+        for (xi, &s) in x.iter_mut().zip(input) {
+            *xi = if s.is_finite() { gain * s } else { 0.0 };
+            heard |= *xi != 0.0;
+        }
+        if heard {
+            self.input_heard = true;
+            if self.input_dormant {
+                self.input_dormant = false;
+                if self.decay_stale != Stale::Fresh {
+                    self.rebuild_decay_table();
+                }
+                let key = self
+                    .last_key
+                    .unwrap_or(self.bank.root_key.round().clamp(0.0, 127.0) as u8);
+                let target = target_log_pitch(&self.controls, self.bank.root_key, key);
+                let weights = self
+                    .bank
+                    .positions
+                    .weights(self.controls.strike_x, self.controls.strike_y);
+                let Some(v) = self.input_voice.as_mut() else {
+                    return;
+                };
+                if v.modes.num_live() == 0 {
+                    v.log_pitch = target;
+                }
+                let tuning = tuning_of(v, self.damping_version, 0.0);
+                // Every mode in range; the strike itself adds nothing (amplitude 0).
+                v.strike(
+                    &self.bank,
+                    &self.decay,
+                    self.sample_rate_hz,
+                    tuning,
+                    &weights,
+                    ExciterKind::Impulse,
+                    0.0,
+                    1,
+                    0.0,
+                );
+                v.exciter.reset();
+            }
+        }
+        let Some(v) = self.input_voice.as_mut() else {
+            return;
+        };
+        let acc = &mut self.acc[..n];
+        if heard {
+            v.modes
+                .process(self.kernel, Some(&self.excitation[..n]), acc);
+        } else if v.modes.num_live() > 0 {
+            v.modes.process(self.kernel, None, acc);
         }
     }
 }

@@ -137,14 +137,17 @@ impl Bank {
             .min(1e6)
     }
 
-    /// The bank's own quality factor: the median of `pi f / d` over the modes that decay, or
-    /// `None` when none does. Material Q scales decays relative to it.
+    /// The bank's own quality factor: the median of `pi f / d` over its modes, with `d` at least
+    /// `MIN_DECAY_PER_S` (the slowest decay the engine plays), or `None` for a bank without
+    /// modes. Material Q scales decays relative to it: at this Q the bank sounds as authored.
     pub fn reference_q(&self) -> Option<f64> {
         let mut qs: Vec<f64> = self
             .modes
             .iter()
-            .filter(|m| m.decay_per_s > 0.0)
-            .map(|m| std::f64::consts::PI * m.freq_hz / m.decay_per_s)
+            .map(|m| {
+                std::f64::consts::PI * m.freq_hz
+                    / m.decay_per_s.max(crate::dsp::coeffs::MIN_DECAY_PER_S)
+            })
             .collect();
         if qs.is_empty() {
             return None;

@@ -185,8 +185,9 @@ pub(crate) fn finish_modes(
 /// A complete bank for `shape` made of `material`, struck at `positions`.
 ///
 /// `description` may be empty, in which case the shape's [`Shape::summary`] is used. The bank's
-/// `root_hz` is [`Shape::root_hz`]; its defaults suit the object (mallet hardness, and the
-/// strike position nearest [`Shape::typical_strike`]).
+/// `root_hz` is [`Shape::root_hz`]; its default mallet hardness suits the object. The position
+/// nearest [`Shape::typical_strike`] comes first, since a bank is played at its first position
+/// unless told otherwise (and is normalised there); the others keep their order.
 pub fn build_bank(
     name: &str,
     description: &str,
@@ -195,6 +196,7 @@ pub fn build_bank(
     positions: &[Position],
     limits: &ModeLimits,
 ) -> Result<Bank, ShapeError> {
+    let positions = &nearest_first(positions, &shape.typical_strike());
     let modes = shape.modes(material, positions, limits)?;
 
     let mut source = Map::new();
@@ -219,17 +221,13 @@ pub fn build_bank(
     bank.modes = modes;
     bank.defaults = Some(BankDefaults {
         hardness_ms: Some(shape.default_hardness_ms(material)),
-        strike_position: Some(nearest_position_fraction(
-            positions,
-            &shape.typical_strike(),
-        )),
         ..BankDefaults::default()
     });
     Ok(bank)
 }
 
-/// Index of the position nearest `coords`, as a fraction of the position list (0 to 1).
-fn nearest_position_fraction(positions: &[Position], coords: &[f64]) -> f64 {
+/// `positions` with the one nearest `coords` moved to the front.
+fn nearest_first(positions: &[Position], coords: &[f64]) -> Vec<Position> {
     let distance = |p: &Position| -> f64 {
         p.coords
             .iter()
@@ -237,14 +235,14 @@ fn nearest_position_fraction(positions: &[Position], coords: &[f64]) -> f64 {
             .map(|(a, b)| (a - b) * (a - b))
             .sum()
     };
-    let nearest = (0..positions.len())
+    let mut ordered = positions.to_vec();
+    if let Some(nearest) = (0..positions.len())
         .min_by(|&a, &b| distance(&positions[a]).total_cmp(&distance(&positions[b])))
-        .unwrap_or(0);
-    if positions.len() > 1 {
-        nearest as f64 / (positions.len() - 1) as f64
-    } else {
-        0.0
+    {
+        let first = ordered.remove(nearest);
+        ordered.insert(0, first);
     }
+    ordered
 }
 
 #[cfg(test)]

@@ -401,7 +401,21 @@ fn every_shape_gives_a_sane_bank() {
         assert_eq!(source["shape"], shape.kind());
         assert_eq!(source["material"], material.name);
         let defaults = bank.defaults.as_ref().unwrap();
-        assert!((0.0..=1.0).contains(&defaults.strike_position.unwrap()));
+        // Played at the first position by default: the one nearest the typical strike.
+        assert_eq!(defaults.strike_position, None);
+        let typical = shape.typical_strike();
+        let distance = |p: &Position| -> f64 {
+            p.coords
+                .iter()
+                .zip(&typical)
+                .map(|(a, b)| (a - b).powi(2))
+                .sum()
+        };
+        let first = distance(&bank.positions[0]);
+        assert!(
+            bank.positions.iter().all(|p| distance(p) >= first),
+            "{what}: first position is not the typical strike"
+        );
         assert!(defaults.hardness_ms.unwrap() > 0.0);
         assert_eq!(defaults.material_q, None);
     }
