@@ -23,18 +23,6 @@ fn preset_files() -> Vec<PathBuf> {
     files
 }
 
-/// Magnitude of the spectrum of `x` at `freq_hz` (a single DFT bin at any frequency).
-fn magnitude_at(x: &[f32], rate: f64, freq_hz: f64) -> f64 {
-    let w = std::f64::consts::TAU * freq_hz / rate;
-    let (mut re, mut im) = (0.0, 0.0);
-    for (n, &v) in x.iter().enumerate() {
-        let hann = 0.5 - 0.5 * (std::f64::consts::TAU * n as f64 / x.len() as f64).cos();
-        re += hann * v as f64 * (w * n as f64).cos();
-        im -= hann * v as f64 * (w * n as f64).sin();
-    }
-    (re * re + im * im).sqrt()
-}
-
 #[test]
 fn there_are_at_least_six_presets() {
     assert!(preset_files().len() >= 6, "{:?}", preset_files());

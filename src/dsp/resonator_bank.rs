@@ -38,6 +38,8 @@ pub struct ResonatorBank {
     live: [u32; COLUMNS],
     /// Rows handed to the kernel: the fullest column, rounded up to whole row blocks.
     rows_active: usize,
+    /// Modes started since the bank was last cleared (counting restarts).
+    num_started: usize,
     /// Scratch: pole angle of each slot, for batch coefficient updates.
     theta: Vec<f64>,
     /// Scratch: pole radius exponent of each slot, for batch coefficient updates.
@@ -59,6 +61,7 @@ impl ResonatorBank {
             slot_of_mode: vec![NONE; num_modes],
             live: [0; COLUMNS],
             rows_active: 0,
+            num_started: 0,
             theta: vec![0.0; slots],
             delta: vec![0.0; slots],
         }
@@ -77,6 +80,12 @@ impl ResonatorBank {
     /// Number of modes the kernel advances per sample (live modes plus padding).
     pub fn num_computed(&self) -> usize {
         self.rows_active * COLUMNS
+    }
+
+    /// Modes started since the bank was last cleared, counting a mode started again after it
+    /// was retired.
+    pub fn num_started(&self) -> usize {
+        self.num_started
     }
 
     /// Whether mode `mode` is sounding.
@@ -110,6 +119,7 @@ impl ResonatorBank {
         self.gain[slot] = gain;
         self.mode_of_slot[slot] = mode as u32;
         self.slot_of_mode[mode] = slot as u32;
+        self.num_started += 1;
         self.update_rows();
         true
     }
@@ -222,6 +232,7 @@ impl ResonatorBank {
         }
         self.live = [0; COLUMNS];
         self.rows_active = 0;
+        self.num_started = 0;
         self.slot_of_mode.fill(NONE);
     }
 

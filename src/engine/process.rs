@@ -61,6 +61,23 @@ impl Engine {
         )
     }
 
+    /// Sets every smoothed value to its target at once.
+    fn snap_smoothing(&mut self) {
+        let (log_damping, tilt) = self.damping_targets();
+        let s = &mut self.smoothed;
+        if s.tilt != tilt {
+            self.decay_stale = Stale::Tilt;
+        } else if s.log_damping != log_damping {
+            self.decay_stale = self.decay_stale.max(Stale::Damping);
+        }
+        s.log_damping = log_damping;
+        s.tilt = tilt;
+        s.gain = db_to_gain(self.controls.output_gain_db);
+        s.weights = lane_weights(self.controls.width);
+        s.weight_target = s.weights;
+        s.weight_ramp_left = 0;
+    }
+
     /// Brings the decay table up to the smoothed material: a tilt change costs an `exp` per
     /// mode, a Q change only a multiply.
     pub(super) fn rebuild_decay_table(&mut self) {
@@ -96,23 +113,29 @@ impl Engine {
 
     /// Smoothing steps, truncation, freeing and coefficient updates, every `CONTROL_PERIOD`.
     fn control_tick(&mut self) {
-        // Material.
-        let (target_damping, target_tilt) = self.damping_targets();
-        let k = self.tick_coefficient(DAMPING_SMOOTHING_S);
-        let s = &mut self.smoothed;
-        if s.log_damping != target_damping || s.tilt != target_tilt {
-            let tilt_moved = s.tilt != target_tilt;
-            s.log_damping = step_towards(s.log_damping, target_damping, k, 1e-4);
-            s.tilt = step_towards(s.tilt, target_tilt, k, 1e-4);
-            self.decay_stale = self.decay_stale.max(if tilt_moved {
-                Stale::Tilt
-            } else {
-                Stale::Damping
-            });
-        }
-        // Only sounding voices need the table now; a note-on brings it up to date otherwise.
-        if self.decay_stale != Stale::Fresh && !self.is_silent() {
-            self.rebuild_decay_table();
+        let silent = self.is_silent();
+        if silent {
+            // Nothing sounds, so nothing can zipper: jump to the targets.
+            self.snap_smoothing();
+        } else {
+            let (target_damping, target_tilt) = self.damping_targets();
+            let k = self.tick_coefficient(DAMPING_SMOOTHING_S);
+            let s = &mut self.smoothed;
+            if s.log_damping != target_damping || s.tilt != target_tilt {
+                let tilt_moved = s.tilt != target_tilt;
+                s.log_damping = step_towards(s.log_damping, target_damping, k, 1e-4);
+                s.tilt = step_towards(s.tilt, target_tilt, k, 1e-4);
+                let stale = if tilt_moved {
+                    Stale::Tilt
+                } else {
+                    Stale::Damping
+                };
+                self.decay_stale = self.decay_stale.max(stale);
+            }
+            // Only sounding voices need the table now; a note-on brings it up to date otherwise.
+            if self.decay_stale != Stale::Fresh {
+                self.rebuild_decay_table();
+            }
         }
         // Stereo width: ramp the column weights over the next period.
         let target = lane_weights(self.controls.width);
@@ -148,13 +171,13 @@ impl Engine {
                 continue;
             }
             if v.exciter.is_idle() && !(is_input && input_heard) {
-                // Each mode gets an equal share of the threshold's energy, so all the modes
-                // retired at once drop less than the threshold (seed 000 section 5.4.2 applies
-                // the threshold to each mode alone, which lets hundreds of dropped modes add up).
+                // Each mode started gets an equal share of the threshold's energy, so all a
+                // voice ever drops adds up to less than the threshold. (Seed 000 section 5.4.2
+                // applies the threshold to each mode alone, which lets hundreds of dropped modes
+                // add up to far more.)
                 let live = v.modes.num_live();
-                v.energy = v
-                    .modes
-                    .retire_below(threshold / (live.max(1) as f32).sqrt());
+                let share = (v.modes.num_started().max(1) as f32).sqrt();
+                v.energy = v.modes.retire_below(threshold / share);
                 if is_input && v.modes.num_live() < live {
                     self.input_dormant = true;
                 }

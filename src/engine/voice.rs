@@ -138,6 +138,8 @@ impl Voice {
     ) {
         let pitch = tuning.log_pitch.exp();
         let bound = amplitude * kind.peak_bound(len_samples);
+        // Modes left out share the threshold's energy, like modes retired later.
+        let threshold = threshold / (bank.num_modes().max(1) as f32).sqrt();
         for m in 0..bank.num_modes() {
             if self.modes.is_live(m) {
                 continue;

@@ -167,3 +167,15 @@ pub fn pitch_hz(x: &[f32], rate: f64, lo_hz: f64, hi_hz: f64) -> f64 {
     let shift = 0.5 * (a - c) / (a - 2.0 * b + c);
     rate / (l as f64 + shift)
 }
+
+/// Magnitude of the spectrum of `x` at `freq_hz` (a single DFT bin at any frequency).
+pub fn magnitude_at(x: &[f32], rate: f64, freq_hz: f64) -> f64 {
+    let w = std::f64::consts::TAU * freq_hz / rate;
+    let (mut re, mut im) = (0.0, 0.0);
+    for (n, &v) in x.iter().enumerate() {
+        let hann = 0.5 - 0.5 * (std::f64::consts::TAU * n as f64 / x.len() as f64).cos();
+        re += hann * v as f64 * (w * n as f64).cos();
+        im -= hann * v as f64 * (w * n as f64).sin();
+    }
+    (re * re + im * im).sqrt()
+}
