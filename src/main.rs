@@ -170,7 +170,24 @@ fn run_render(args: &RenderArgs) -> Result<(), String> {
         (None, Some(path)) => read_midi_file(path).map_err(|e| e.to_string())?,
         (None, None) => unreachable!("clap requires --notes or --midi"),
     };
+    if let Some(late) = notes.iter().position(|n| n.time_s >= args.max_seconds) {
+        return Err(format!(
+            "note {} starts at {} s, at or after --max-seconds {}",
+            late + 1,
+            notes[late].time_s,
+            args.max_seconds
+        ));
+    }
     check_output_dir(&args.output)?;
+    let inputs = [Some(Path::new(&args.bank)), args.midi.as_deref()];
+    for input in inputs.into_iter().flatten() {
+        if same_file(input, &args.output) {
+            return Err(format!(
+                "{}: the output would overwrite an input",
+                args.output.display()
+            ));
+        }
+    }
     let settings = RenderSettings {
         sample_rate_hz: args.rate,
         bit_depth: args.bits,
@@ -231,6 +248,14 @@ fn check_output_dir(output: &Path) -> Result<(), String> {
             dir.display()
         )),
         _ => Ok(()),
+    }
+}
+
+/// Whether `a` and `b` name the same existing file.
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
     }
 }
 

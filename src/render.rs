@@ -24,6 +24,25 @@ use crate::model::Bank;
 /// player does not cut the very end of the tail.
 pub const TAIL_MARGIN_S: f64 = 0.1;
 
+/// Length of the fade applied when the maximum length cuts a sound short, in seconds: long
+/// enough not to click.
+pub const CUT_FADE_S: f64 = 0.01;
+
+/// Fades the last `len` samples of both channels linearly to zero.
+fn fade_out(left: &mut [f32], right: &mut [f32], len: usize) {
+    let len = len.min(left.len());
+    let start = left.len() - len;
+    for (i, (l, r)) in left[start..]
+        .iter_mut()
+        .zip(&mut right[start..])
+        .enumerate()
+    {
+        let gain = 1.0 - (i + 1) as f32 / len as f32;
+        *l *= gain;
+        *r *= gain;
+    }
+}
+
 /// Most samples per channel reserved up front (about 87 s at 48 kHz): the tail estimate can be
 /// far longer than the sound when notes are released early.
 const MAX_RESERVED_SAMPLES: usize = 1 << 22;
@@ -304,6 +323,9 @@ pub fn render(
     };
     left.resize(end as usize, 0.0);
     right.resize(end as usize, 0.0);
+    if sounding {
+        fade_out(&mut left, &mut right, (CUT_FADE_S * rate) as usize);
+    }
     progress(1.0);
     Rendered {
         left,

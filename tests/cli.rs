@@ -277,6 +277,51 @@ fn bad_notes_fail_and_write_nothing() {
         ],
     );
     assert_failed_cleanly(&out, &["missing.mid"], dir.path(), &[]);
+    let out = run(
+        dir.path(),
+        &[
+            "render",
+            "bank.json",
+            "--notes",
+            "60:1@0, 62:1@100",
+            "-o",
+            "out.wav",
+        ],
+    );
+    assert_failed_cleanly(
+        &out,
+        &["note 2 starts at 100 s", "--max-seconds 30"],
+        dir.path(),
+        &[],
+    );
+    let before = std::fs::read(dir.path().join("bank.json")).unwrap();
+    let out = run(
+        dir.path(),
+        &[
+            "render",
+            "bank.json",
+            "--notes",
+            "60:1@0",
+            "-o",
+            "./bank.json",
+        ],
+    );
+    assert_failed_cleanly(&out, &["would overwrite an input"], dir.path(), &[]);
+    assert_eq!(std::fs::read(dir.path().join("bank.json")).unwrap(), before);
+    let out = run(
+        dir.path(),
+        &[
+            "render",
+            "bank.json",
+            "--notes",
+            "60:1@0",
+            "--set",
+            "polyphony=2.5",
+            "-o",
+            "out.wav",
+        ],
+    );
+    assert_failed_cleanly(&out, &["polyphony", "whole number"], dir.path(), &[]);
     // Neither notes nor a MIDI file.
     let out = run(dir.path(), &["render", "bank.json", "-o", "out.wav"]);
     assert_failed_cleanly(&out, &["--notes", "--midi"], dir.path(), &[]);

@@ -155,6 +155,8 @@ pub struct ControlSpec {
     pub min: f32,
     /// Largest value.
     pub max: f32,
+    /// Whether only whole numbers are meaningful.
+    pub integer: bool,
     /// Reads the control.
     pub get: fn(&Controls) -> f32,
     /// Writes the control (the value is already clamped to the range).
@@ -163,11 +165,15 @@ pub struct ControlSpec {
 
 macro_rules! spec {
     ($name:literal, $unit:literal, $min:expr, $max:expr, $field:ident) => {
+        spec!($name, $unit, $min, $max, $field, false)
+    };
+    ($name:literal, $unit:literal, $min:expr, $max:expr, $field:ident, $integer:expr) => {
         ControlSpec {
             name: $name,
             unit: $unit,
             min: $min,
             max: $max,
+            integer: $integer,
             get: |c| c.$field as f32,
             set: |c, v| c.$field = v as _,
         }
@@ -196,7 +202,14 @@ pub const NUMERIC_CONTROLS: &[ControlSpec] = &[
     spec!("velocity_to_hardness", "", 0.0, 1.0, velocity_to_hardness),
     spec!("release_damping", "", 0.0, 1.0, release_damping),
     spec!("truncation_db", "dBFS", -140.0, -60.0, truncation_db),
-    spec!("polyphony", "voices", 1.0, MAX_POLYPHONY as f32, polyphony),
+    spec!(
+        "polyphony",
+        "voices",
+        1.0,
+        MAX_POLYPHONY as f32,
+        polyphony,
+        true
+    ),
     spec!("width", "", 0.0, 1.0, width),
     spec!("output_gain_db", "dB", -60.0, 12.0, output_gain_db),
     spec!("input_gain_db", "dB", -60.0, 24.0, input_gain_db),
@@ -310,6 +323,12 @@ impl Controls {
                         )
                     })?;
                 let v = parse_in_range(name, value, spec.min, spec.max)?;
+                if spec.integer && v.fract() != 0.0 {
+                    return Err(format!(
+                        "{name}: expected a whole number from {} to {}, found {v}",
+                        spec.min, spec.max
+                    ));
+                }
                 (spec.set)(self, v);
                 Ok(())
             }
@@ -368,6 +387,10 @@ mod tests {
             .set_by_name("exciter", "hammer")
             .unwrap_err()
             .contains("impulse, mallet, noise"));
+        assert!(c
+            .set_by_name("polyphony", "2.5")
+            .unwrap_err()
+            .contains("whole number"));
         c.set_by_name("polyphony", "8").unwrap();
         assert_eq!(c.polyphony, 8);
     }

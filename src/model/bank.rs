@@ -17,10 +17,13 @@ pub const FORMAT_VERSION: u32 = 1;
 #[serde(deny_unknown_fields)]
 pub struct Bank {
     /// Always `"modal-bank"`.
+    #[schemars(extend("const" = "modal-bank"))]
     pub format: String,
     /// Major format version; this build reads version 1.
+    #[schemars(extend("const" = 1))]
     pub version: u32,
     /// Display name, for example "Steel bar, 30 cm".
+    #[schemars(length(min = 1))]
     pub name: String,
     /// What the object is and how it sounds.
     #[serde(default)]
@@ -38,10 +41,13 @@ pub struct Bank {
     /// Pitch in Hz the bank sounds at size 1: the MIDI key with this equal-tempered pitch plays the
     /// bank as authored. When absent, the lowest of the strongest modes.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("exclusiveMinimum" = 0, "maximum" = 1_000_000))]
     pub root_hz: Option<f64>,
     /// The strike positions whose gains each mode lists, in order.
+    #[schemars(length(min = 1, max = 64))]
     pub positions: Vec<Position>,
     /// The modes, in any order.
+    #[schemars(length(min = 1, max = 65_536))]
     pub modes: Vec<Mode>,
     /// Parameter defaults that suit this bank.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -53,9 +59,11 @@ pub struct Bank {
 #[serde(deny_unknown_fields)]
 pub struct Position {
     /// Display name, for example "edge" or "centre".
+    #[schemars(length(min = 1))]
     pub name: String,
     /// Coordinates on the object: one value (along a line) or two (on a surface), in any unit
     /// consistent within the bank (usually fractions of the object's length).
+    #[schemars(length(min = 1, max = 2))]
     pub coords: Vec<f64>,
 }
 
@@ -64,10 +72,13 @@ pub struct Position {
 #[serde(deny_unknown_fields)]
 pub struct Mode {
     /// Frequency in Hz at size 1.
+    #[schemars(extend("exclusiveMinimum" = 0, "maximum" = 1_000_000))]
     pub freq_hz: f64,
     /// Exponential decay rate of the amplitude in 1/s (T60 = 3 ln 10 / decay).
+    #[schemars(range(min = 0, max = 1_000_000))]
     pub decay_per_s: f64,
     /// Signed linear amplitude of the mode for a unit impulse at each position, one per position.
+    #[schemars(length(min = 1, max = 64), inner(range(min = -1_000_000, max = 1_000_000)))]
     pub gains: Vec<f64>,
 }
 
@@ -77,18 +88,23 @@ pub struct Mode {
 pub struct BankDefaults {
     /// Material quality factor Q (decays scale by the bank's own Q over this one).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 1, max = 100_000))]
     pub material_q: Option<f64>,
     /// Damping tilt: decays scale by `(f / f_lowest) ^ tilt`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = -2, max = 2))]
     pub damping_tilt: Option<f64>,
     /// Mallet contact time in milliseconds (short = hard and bright).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 0.05, max = 20))]
     pub hardness_ms: Option<f64>,
     /// Strike position along the bank's positions, 0 to 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 0, max = 1))]
     pub strike_position: Option<f64>,
     /// Key tracking in percent (0 = every key plays the bank's own pitch).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 0, max = 100))]
     pub key_tracking_pct: Option<f64>,
 }
 
