@@ -37,8 +37,11 @@ fn bank_of(num_modes: usize) -> ResonatorBank {
     bank
 }
 
-fn mode_samples_per_s(kernel: Kernel, num_modes: usize, work: usize) -> f64 {
+/// Mode-samples per second of `kernel` on `num_modes` modes; with `driven`, every sample has
+/// input (as for audio driving the bank), else none (ringing between strikes).
+fn mode_samples_per_s(kernel: Kernel, num_modes: usize, work: usize, driven: bool) -> f64 {
     let blocks = (work / (num_modes * BLOCK)).max(1);
+    let input: Vec<f32> = (0..BLOCK).map(|n| ((n * 7) % 13) as f32 * 1e-3).collect();
     let mut best = f64::INFINITY;
     for _ in 0..REPEATS {
         let mut bank = bank_of(num_modes);
@@ -46,7 +49,7 @@ fn mode_samples_per_s(kernel: Kernel, num_modes: usize, work: usize) -> f64 {
         let start = Instant::now();
         for _ in 0..blocks {
             acc.fill([0.0; COLUMNS]);
-            bank.process(kernel, None, &mut acc);
+            bank.process(kernel, driven.then_some(&input[..]), &mut acc);
             black_box(&mut acc);
         }
         best = best.min(start.elapsed().as_secs_f64());
@@ -128,7 +131,7 @@ fn main() {
         let mut figures = Vec::new();
         for &k in &kernels {
             let w = if k == Kernel::Scalar { work / 8 } else { work };
-            let v = mode_samples_per_s(k, n, w);
+            let v = mode_samples_per_s(k, n, w, false);
             figures.push((k, v));
             print!("{:>14.3e}", v);
         }
@@ -140,6 +143,22 @@ fn main() {
             None => print!("{:>12}", "-"),
         }
         println!("{:>12.1}", best / scalar);
+    }
+    println!();
+    println!("Driven by input on every sample, 4096 modes (one operation more per mode group):");
+    for &k in &kernels {
+        let w = if k == Kernel::Scalar { work / 8 } else { work };
+        let (quiet, driven) = (
+            mode_samples_per_s(k, 4096, w, false),
+            mode_samples_per_s(k, 4096, w, true),
+        );
+        println!(
+            "  {:<10} {:>12.3e} driven, {:>12.3e} without input ({:.2}x)",
+            k.name(),
+            driven,
+            quiet,
+            quiet / driven
+        );
     }
     println!();
     println!("Engine, 16 voices x 256 modes, 48 kHz, {BLOCK}-sample blocks:");
