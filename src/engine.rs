@@ -37,6 +37,9 @@ use crate::dsp::{Kernel, COLUMNS};
 /// Samples between control updates: smoothing steps, coefficient updates and mode truncation.
 pub const CONTROL_PERIOD: usize = 64;
 
+/// Decay multiplier at full extra damping.
+const MAX_EXTRA_DAMPING: f64 = 20.0;
+
 /// Voices beyond the polyphony limit, used by stolen voices while they fade.
 const FADE_SLOTS: usize = 8;
 

@@ -7,4 +7,8 @@
 pub mod dsp;
 pub mod engine;
 pub mod model;
+pub mod params;
+pub mod plugin;
 pub mod render;
+
+pub use plugin::{ModalResonator, ModalResonatorFx};

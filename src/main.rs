@@ -1,4 +1,5 @@
-//! The `modal-resonator` command: renders banks offline, inspects and validates them.
+//! The `modal-resonator` command: plays the instrument standalone, renders banks offline,
+//! inspects and validates them.
 //! Thin over the library: every decision about sound lives in `modal_resonator`.
 
 use std::io::IsTerminal;
@@ -7,7 +8,7 @@ use std::process::ExitCode;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use clap::{Args, CommandFactory, Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use modal_resonator::engine::{Controls, PreparedBank};
@@ -29,7 +30,7 @@ const PROGRESS_STEPS: u64 = 1000;
 #[derive(Debug, Parser)]
 #[command(name = "modal-resonator", version, about)]
 struct Cli {
-    /// What to do; with none, prints this help.
+    /// What to do; with none, plays the instrument standalone (as `play`).
     #[command(subcommand)]
     command: Option<Command>,
 }
@@ -37,6 +38,13 @@ struct Cli {
 /// The subcommands.
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// Play the instrument standalone: audio and MIDI through JACK or ALSA (`--backend dummy`
+    /// runs headless). Options after `play` go to the standalone; `play --help` lists them.
+    Play {
+        /// Standalone options, e.g. --backend alsa --sample-rate 48000 --period-size 256.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
     /// Render notes or a MIDI file through a bank to a stereo WAV file.
     Render(RenderArgs),
     /// Check bank files and print every problem found.
@@ -106,7 +114,8 @@ fn main() -> ExitCode {
             print!("{}", bank_schema_json());
             Ok(())
         }
-        None => Cli::command().print_help().map_err(|e| e.to_string()),
+        Some(Command::Play { args }) => play(args),
+        None => play(Vec::new()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -115,6 +124,26 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Runs the instrument through nice-plug's standalone wrapper until it is stopped.
+#[cfg(feature = "standalone")]
+fn play(args: Vec<String>) -> Result<(), String> {
+    let argv = std::iter::once("modal-resonator".to_string()).chain(args);
+    if nice_plug::prelude::nice_export_standalone_with_args::<modal_resonator::ModalResonator, _>(
+        argv,
+    ) {
+        Ok(())
+    } else {
+        Err("the standalone could not start an audio backend".to_string())
+    }
+}
+
+/// Without the standalone feature there is nothing to play: say so.
+#[cfg(not(feature = "standalone"))]
+fn play(_args: Vec<String>) -> Result<(), String> {
+    let _ = <Cli as clap::CommandFactory>::command().print_help();
+    Err("this build has no standalone player (build with the `standalone` feature)".to_string())
 }
 
 /// Loads the bank named on the command line: a bank file (validated) if `arg` is a path that

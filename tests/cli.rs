@@ -414,14 +414,42 @@ fn an_unwritable_output_fails_and_leaves_nothing() {
 }
 
 #[test]
-fn no_subcommand_prints_help() {
+fn help_lists_the_subcommands() {
     let dir = tempfile::tempdir().unwrap();
-    let out = run(dir.path(), &[]);
+    let out = run(dir.path(), &["--help"]);
     assert!(out.status.success(), "stderr: {}", stderr(&out));
     let help = stdout(&out);
+    for sub in ["play", "render", "validate", "info", "list", "schema"] {
+        assert!(help.contains(sub), "help lacks {sub}: {help}");
+    }
+}
+
+#[test]
+fn the_standalone_runs_headless_with_the_dummy_backend() {
+    // The standalone runs until stopped: start it, let it process for a while, then stop it.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_modal-resonator"))
+        .args([
+            "play",
+            "--backend",
+            "dummy",
+            "--sample-rate",
+            "48000",
+            "--period-size",
+            "256",
+        ])
+        .env_remove("DISPLAY")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("the binary runs");
+    std::thread::sleep(std::time::Duration::from_secs(2));
+    let still_running = child.try_wait().unwrap().is_none();
+    let _ = child.kill();
+    let out = child.wait_with_output().unwrap();
     assert!(
-        help.contains("Usage") && help.contains("render"),
-        "help: {help}"
+        still_running,
+        "the standalone stopped by itself: {}",
+        String::from_utf8_lossy(&out.stderr)
     );
 }
 

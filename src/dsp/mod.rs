@@ -9,6 +9,7 @@ pub mod coeffs_batch;
 pub mod denormal;
 pub mod exciter;
 pub mod kernels;
+pub mod onset;
 pub mod resonator_bank;
 pub mod rng;
 

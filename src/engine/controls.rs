@@ -107,6 +107,9 @@ pub struct Controls {
     pub velocity_to_hardness: f32,
     /// Damping applied on note-off: 0 lets the object ring on, 1 damps it within about 50 ms.
     pub release_damping: f32,
+    /// Extra damping of every mode, 0 (none) to 1 (decays 20 times faster), for expression
+    /// (a hand pressing on the object).
+    pub extra_damping: f32,
     /// A mode stops being computed once its amplitude is below this level, in dBFS.
     pub truncation_db: f32,
     /// Voices that may sound at once.
@@ -136,6 +139,7 @@ impl Default for Controls {
             velocity_sensitivity: 0.8,
             velocity_to_hardness: 0.5,
             release_damping: 0.0,
+            extra_damping: 0.0,
             truncation_db: -96.0,
             polyphony: 16,
             width: 0.5,
@@ -201,6 +205,7 @@ pub const NUMERIC_CONTROLS: &[ControlSpec] = &[
     spec!("velocity_sensitivity", "", 0.0, 1.0, velocity_sensitivity),
     spec!("velocity_to_hardness", "", 0.0, 1.0, velocity_to_hardness),
     spec!("release_damping", "", 0.0, 1.0, release_damping),
+    spec!("extra_damping", "", 0.0, 1.0, extra_damping),
     spec!("truncation_db", "dBFS", -140.0, -60.0, truncation_db),
     spec!(
         "polyphony",

@@ -55,8 +55,9 @@ impl Engine {
 
     /// Natural logs of the decay multiplier and the tilt the controls ask for.
     pub(super) fn damping_targets(&self) -> (f64, f64) {
+        let extra = self.controls.extra_damping as f64 * MAX_EXTRA_DAMPING.ln();
         (
-            self.bank.log_damping(self.controls.material_q),
+            self.bank.log_damping(self.controls.material_q) + extra,
             self.controls.damping_tilt as f64,
         )
     }

@@ -1,0 +1,364 @@
+//! Every host parameter of both plugins, with stable ids, ranges and units, and how they become
+//! the engine's [`Controls`]. The ids never change once released.
+
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+use std::sync::RwLock;
+
+use nice_plug::params::persist::PersistentField;
+use nice_plug::prelude::*;
+
+use crate::dsp::ExciterKind;
+use crate::engine::{Controls, Material, MATERIAL_Q_RANGE, MAX_POLYPHONY};
+
+/// Version of the plugin state's own fields; raised when they change meaning.
+pub const STATE_FORMAT: u32 = 1;
+
+/// Material: the bank as authored, a shortcut, or the Q and tilt knobs.
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MaterialChoice {
+    /// The bank's own decays; the tilt knob still applies.
+    #[id = "authored"]
+    #[name = "As authored"]
+    Authored,
+    /// Q and tilt from their knobs.
+    #[id = "custom"]
+    Custom,
+    #[id = "plastic"]
+    Plastic,
+    #[id = "wood"]
+    Wood,
+    #[id = "ceramic"]
+    Ceramic,
+    #[id = "glass"]
+    Glass,
+    #[id = "metal"]
+    Metal,
+}
+
+/// What strikes the object.
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExciterChoice {
+    #[id = "mallet"]
+    Mallet,
+    #[id = "impulse"]
+    Impulse,
+    #[id = "noise"]
+    #[name = "Noise burst"]
+    Noise,
+}
+
+/// What the audio input does.
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InputMode {
+    /// Ignored.
+    #[id = "off"]
+    Off,
+    /// Drives the modes directly, like a filter bank.
+    #[id = "direct"]
+    Direct,
+    /// Its onsets strike the object.
+    #[id = "trigger"]
+    Trigger,
+}
+
+/// Where the mod wheel or channel pressure goes.
+#[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ExpressionTarget {
+    #[id = "none"]
+    None,
+    /// Moves the strike position towards the far end.
+    #[id = "position"]
+    #[name = "Strike position"]
+    Position,
+    /// Damps the object, as a hand pressing on it.
+    #[id = "damping"]
+    Damping,
+}
+
+/// The bank in use, saved in the plugin state as its JSON text, so a project reopens with the
+/// same sound even when the file has moved. An empty text means the default factory bank.
+#[derive(Default)]
+pub struct BankField {
+    /// The bank's JSON.
+    pub json: RwLock<String>,
+    /// Incremented on every change, so the audio thread notices a restored or loaded bank.
+    pub generation: AtomicU64,
+}
+
+impl BankField {
+    /// Replaces the bank's JSON (from the GUI or a host restoring state).
+    pub fn replace(&self, json: String) {
+        *self.json.write().unwrap_or_else(|e| e.into_inner()) = json;
+        self.generation.fetch_add(1, Ordering::AcqRel);
+    }
+}
+
+impl<'a> PersistentField<'a, String> for BankField {
+    fn set(&self, new_value: String) {
+        self.replace(new_value);
+    }
+
+    fn map<F, R>(&self, f: F) -> R
+    where
+        F: Fn(&String) -> R,
+    {
+        f(&self.json.read().unwrap_or_else(|e| e.into_inner()))
+    }
+}
+
+/// The parameters shared by the instrument and the effect.
+#[derive(Params)]
+pub struct ModalParams {
+    /// The bank, as JSON.
+    #[persist = "bank"]
+    pub bank: BankField,
+    /// [`STATE_FORMAT`] of the state this was saved with.
+    #[persist = "state-format"]
+    pub state_format: AtomicU32,
+
+    #[id = "mat"]
+    pub material: EnumParam<MaterialChoice>,
+    #[id = "q"]
+    pub material_q: FloatParam,
+    #[id = "tilt"]
+    pub damping_tilt: FloatParam,
+    #[id = "size"]
+    pub size: FloatParam,
+    #[id = "keytrk"]
+    pub key_tracking: FloatParam,
+    #[id = "fine"]
+    pub fine_tune: FloatParam,
+    #[id = "bendrg"]
+    pub bend_range: FloatParam,
+    #[id = "posx"]
+    pub strike_x: FloatParam,
+    #[id = "posy"]
+    pub strike_y: FloatParam,
+    #[id = "posvar"]
+    pub position_variation: FloatParam,
+    #[id = "exc"]
+    pub exciter: EnumParam<ExciterChoice>,
+    #[id = "hard"]
+    pub hardness: FloatParam,
+    #[id = "velsns"]
+    pub velocity_sensitivity: FloatParam,
+    #[id = "velhrd"]
+    pub velocity_to_hardness: FloatParam,
+    #[id = "reldmp"]
+    pub release_damping: FloatParam,
+    #[id = "trunc"]
+    pub truncation: FloatParam,
+    #[id = "poly"]
+    pub polyphony: IntParam,
+    #[id = "width"]
+    pub width: FloatParam,
+    #[id = "gain"]
+    pub output_gain: FloatParam,
+    #[id = "inmode"]
+    pub input_mode: EnumParam<InputMode>,
+    #[id = "ingain"]
+    pub input_gain: FloatParam,
+    #[id = "trigth"]
+    pub trigger_threshold: FloatParam,
+    #[id = "retrig"]
+    pub retrigger: FloatParam,
+    #[id = "mix"]
+    pub dry_wet: FloatParam,
+    #[id = "modwhl"]
+    pub mod_wheel_target: EnumParam<ExpressionTarget>,
+    #[id = "press"]
+    pub pressure_target: EnumParam<ExpressionTarget>,
+}
+
+fn percent(name: &str, default: f32) -> FloatParam {
+    FloatParam::new(name, default, FloatRange::Linear { min: 0.0, max: 1.0 })
+        .with_unit("%")
+        .with_value_to_string(formatters::v2s_f32_percentage(0))
+        .with_string_to_value(formatters::s2v_f32_percentage())
+}
+
+fn decibels(name: &str, default: f32, min: f32, max: f32) -> FloatParam {
+    FloatParam::new(name, default, FloatRange::Linear { min, max })
+        .with_unit(" dB")
+        .with_step_size(0.1)
+}
+
+impl ModalParams {
+    /// The parameters with their defaults; `is_effect` sets defaults that suit the effect (input
+    /// driving the modes, half wet).
+    pub fn new(is_effect: bool) -> Self {
+        Self {
+            bank: BankField::default(),
+            state_format: AtomicU32::new(STATE_FORMAT),
+            material: EnumParam::new("Material", MaterialChoice::Authored),
+            material_q: FloatParam::new(
+                "Q",
+                1000.0,
+                FloatRange::Skewed {
+                    min: MATERIAL_Q_RANGE.0,
+                    max: MATERIAL_Q_RANGE.1,
+                    factor: FloatRange::skew_factor(-2.0),
+                },
+            )
+            .with_step_size(1.0),
+            damping_tilt: FloatParam::new(
+                "Damping tilt",
+                0.0,
+                FloatRange::Linear {
+                    min: -2.0,
+                    max: 2.0,
+                },
+            )
+            .with_step_size(0.01),
+            size: FloatParam::new(
+                "Size",
+                1.0,
+                FloatRange::SymmetricalSkewed {
+                    min: 0.25,
+                    max: 4.0,
+                    factor: FloatRange::skew_factor(-1.0),
+                    center: 1.0,
+                },
+            )
+            .with_unit(" x")
+            .with_step_size(0.001)
+            .with_smoother(SmoothingStyle::None),
+            key_tracking: percent("Key tracking", 1.0),
+            fine_tune: FloatParam::new(
+                "Fine tune",
+                0.0,
+                FloatRange::Linear {
+                    min: -100.0,
+                    max: 100.0,
+                },
+            )
+            .with_unit(" ct")
+            .with_step_size(0.1),
+            bend_range: FloatParam::new(
+                "Pitch bend range",
+                2.0,
+                FloatRange::Linear {
+                    min: 0.0,
+                    max: 48.0,
+                },
+            )
+            .with_unit(" st")
+            .with_step_size(1.0),
+            strike_x: percent("Strike position", 0.5),
+            strike_y: percent("Strike position Y", 0.5),
+            position_variation: percent("Position variation", 0.0),
+            exciter: EnumParam::new("Exciter", ExciterChoice::Mallet),
+            hardness: FloatParam::new(
+                "Hardness",
+                0.5,
+                FloatRange::Skewed {
+                    min: 0.05,
+                    max: 20.0,
+                    factor: FloatRange::skew_factor(-2.5),
+                },
+            )
+            .with_unit(" ms")
+            .with_step_size(0.01),
+            velocity_sensitivity: percent("Velocity sensitivity", 0.8),
+            velocity_to_hardness: percent("Velocity to hardness", 0.5),
+            release_damping: percent("Release damping", 0.0),
+            truncation: decibels("Truncation threshold", -96.0, -140.0, -60.0),
+            polyphony: IntParam::new(
+                "Polyphony",
+                16,
+                IntRange::Linear {
+                    min: 1,
+                    max: MAX_POLYPHONY as i32,
+                },
+            ),
+            width: percent("Stereo width", 0.5),
+            output_gain: decibels("Output gain", 0.0, -60.0, 12.0),
+            input_mode: EnumParam::new(
+                "Input mode",
+                if is_effect {
+                    InputMode::Direct
+                } else {
+                    InputMode::Off
+                },
+            ),
+            input_gain: decibels(
+                "Input gain",
+                if is_effect { -24.0 } else { 0.0 },
+                -60.0,
+                24.0,
+            ),
+            trigger_threshold: decibels("Trigger threshold", -30.0, -80.0, 0.0),
+            retrigger: FloatParam::new(
+                "Retrigger time",
+                50.0,
+                FloatRange::Linear {
+                    min: 5.0,
+                    max: 500.0,
+                },
+            )
+            .with_unit(" ms")
+            .with_step_size(1.0),
+            dry_wet: percent("Dry/wet", if is_effect { 0.5 } else { 1.0 }),
+            mod_wheel_target: EnumParam::new("Mod wheel", ExpressionTarget::Position),
+            pressure_target: EnumParam::new("Pressure", ExpressionTarget::Damping),
+        }
+    }
+
+    /// The engine controls for the current values, with the channel's expression: pitch bend
+    /// (-1 to 1), mod wheel and pressure (0 to 1).
+    pub fn controls(&self, bend: f32, mod_wheel: f32, pressure: f32) -> Controls {
+        let (material_q, damping_tilt) = match self.material.value() {
+            MaterialChoice::Authored => (None, self.damping_tilt.value()),
+            MaterialChoice::Custom => (Some(self.material_q.value()), self.damping_tilt.value()),
+            MaterialChoice::Plastic => (
+                Some(Material::Plastic.q()),
+                Material::Plastic.damping_tilt(),
+            ),
+            MaterialChoice::Wood => (Some(Material::Wood.q()), Material::Wood.damping_tilt()),
+            MaterialChoice::Ceramic => (
+                Some(Material::Ceramic.q()),
+                Material::Ceramic.damping_tilt(),
+            ),
+            MaterialChoice::Glass => (Some(Material::Glass.q()), Material::Glass.damping_tilt()),
+            MaterialChoice::Metal => (Some(Material::Metal.q()), Material::Metal.damping_tilt()),
+        };
+        let mut strike_x = self.strike_x.value();
+        let mut extra_damping = 0.0;
+        for (target, amount) in [
+            (self.mod_wheel_target.value(), mod_wheel),
+            (self.pressure_target.value(), pressure),
+        ] {
+            match target {
+                ExpressionTarget::None => {}
+                ExpressionTarget::Position => strike_x += amount * (1.0 - strike_x),
+                ExpressionTarget::Damping => extra_damping += amount,
+            }
+        }
+        Controls {
+            material_q,
+            damping_tilt,
+            size_ratio: self.size.value(),
+            key_tracking: self.key_tracking.value(),
+            fine_tune_cents: self.fine_tune.value(),
+            pitch_bend_semitones: bend * self.bend_range.value(),
+            strike_x,
+            strike_y: self.strike_y.value(),
+            position_variation: self.position_variation.value(),
+            exciter: match self.exciter.value() {
+                ExciterChoice::Mallet => ExciterKind::Mallet,
+                ExciterChoice::Impulse => ExciterKind::Impulse,
+                ExciterChoice::Noise => ExciterKind::Noise,
+            },
+            hardness_ms: self.hardness.value(),
+            velocity_sensitivity: self.velocity_sensitivity.value(),
+            velocity_to_hardness: self.velocity_to_hardness.value(),
+            release_damping: self.release_damping.value(),
+            extra_damping: extra_damping.min(1.0),
+            truncation_db: self.truncation.value(),
+            polyphony: self.polyphony.value().clamp(1, MAX_POLYPHONY as i32) as usize,
+            width: self.width.value(),
+            output_gain_db: self.output_gain.value(),
+            input_gain_db: self.input_gain.value(),
+        }
+    }
+}
