@@ -1,0 +1,427 @@
+//! The built `.clap` bundle in a real CLAP host (clack-host): descriptors, notes in, pitch and
+//! level out, the exciter input, the effect, and a state round trip with a bank in it.
+//!
+//! Needs the bundle: `cargo xtask bundle modal-resonator --release` (the README's test command
+//! builds it first).
+
+mod common;
+
+use std::ffi::CStr;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::OnceLock;
+
+use clack_extensions::state::PluginState;
+use clack_host::events::event_types::*;
+use clack_host::events::Match;
+use clack_host::prelude::*;
+use common::{peak, pitch_hz};
+
+const RATE: f64 = 48_000.0;
+const BLOCK: usize = 256;
+const INSTRUMENT: &CStr = c"org.modal-resonator.instrument";
+const EFFECT: &CStr = c"org.modal-resonator.effect";
+
+struct Shared {
+    state_ext: OnceLock<Option<PluginState>>,
+    callback_requested: AtomicBool,
+}
+
+impl<'a> SharedHandler<'a> for Shared {
+    fn initializing(&self, instance: InitializingPluginHandle<'a>) {
+        let _ = self.state_ext.set(instance.get_extension());
+    }
+    fn request_restart(&self) {}
+    fn request_process(&self) {}
+    fn request_callback(&self) {
+        self.callback_requested.store(true, Ordering::SeqCst);
+    }
+}
+
+struct Host;
+impl HostHandlers for Host {
+    type Shared<'a> = Shared;
+    type MainThread<'a> = ();
+    type AudioProcessor<'a> = ();
+}
+
+/// The CLAP bundle built by `cargo xtask bundle`, next to this test's target directory.
+fn bundle() -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    // target/<profile>/deps/<test> -> target
+    let target = exe
+        .parent()
+        .and_then(|p| p.parent())
+        .and_then(|p| p.parent())
+        .unwrap();
+    let path = target.join("bundled").join("Modal Resonator.clap");
+    assert!(
+        path.exists(),
+        "{} is missing: run `cargo xtask bundle modal-resonator --release` first",
+        path.display()
+    );
+    path
+}
+
+/// The CLAP parameter id nice-plug derives from a parameter's string id.
+fn param_id(id: &str) -> ClapId {
+    let mut hash: u32 = 0;
+    for b in id.bytes() {
+        hash = hash.wrapping_mul(31).wrapping_add(b as u32);
+    }
+    ClapId::new(hash & !(1 << 31))
+}
+
+/// Something the host sends at an absolute sample time.
+#[derive(Clone, Copy)]
+enum Send {
+    On(u16, f64),
+    Off(u16),
+    /// A parameter by string id, in CLAP's value (normalised 0..1, or the index of an enum).
+    Param(&'static str, f64),
+}
+
+/// What one session with a plugin produced.
+struct Session {
+    left: Vec<f32>,
+    right: Vec<f32>,
+    state: Vec<u8>,
+}
+
+/// Loads `plugin` from the bundle, restores `state` if given, activates at 48 kHz, plays `events`
+/// with `input` on the input port, renders `samples` samples, saves the state and returns.
+fn session(
+    plugin: &CStr,
+    state: Option<&[u8]>,
+    events: &[(usize, Send)],
+    input: Option<&[Vec<f32>; 2]>,
+    samples: usize,
+) -> Session {
+    let host_info = HostInfo::new(
+        "modal-resonator-tests",
+        "Modal Resonator",
+        "https://modal-resonator.org",
+        "0.1.0",
+    )
+    .unwrap();
+    // SAFETY: the bundle is our own plugin, built for this machine.
+    let entry = unsafe { PluginEntry::load(bundle()) }.expect("the bundle loads");
+    let mut instance = PluginInstance::<Host>::new(
+        |_| Shared {
+            state_ext: OnceLock::new(),
+            callback_requested: AtomicBool::new(false),
+        },
+        |_| (),
+        &entry,
+        plugin,
+        &host_info,
+    )
+    .expect("the plugin instantiates");
+    let state_ext = instance
+        .access_shared_handler(|h| *h.state_ext.get().unwrap())
+        .expect("state extension");
+    if let Some(bytes) = state {
+        state_ext
+            .load(
+                &mut instance.plugin_handle(),
+                &mut std::io::Cursor::new(bytes.to_vec()),
+            )
+            .expect("state loads");
+    }
+    let config = PluginAudioConfiguration {
+        sample_rate: RATE,
+        min_frames_count: 1,
+        max_frames_count: BLOCK as u32,
+    };
+    let processor = instance
+        .activate(|_, _| (), config)
+        .expect("the plugin activates");
+    let mut left = Vec::with_capacity(samples);
+    let mut right = Vec::with_capacity(samples);
+    let processor = std::thread::scope(|s| {
+        s.spawn(|| {
+            let mut p = processor.start_processing().unwrap();
+            let mut in_ports = AudioPorts::with_capacity(2, 1);
+            let mut out_ports = AudioPorts::with_capacity(2, 1);
+            let mut out_events = EventBuffer::new();
+            let mut start = 0;
+            while start < samples {
+                let n = BLOCK.min(samples - start);
+                let mut evs = EventBuffer::new();
+                for &(t, e) in events
+                    .iter()
+                    .filter(|(t, _)| (start..start + n).contains(t))
+                {
+                    let time = (t - start) as u32;
+                    match e {
+                        Send::On(key, vel) => evs.push(&NoteOnEvent::new(
+                            time,
+                            Pckn::new(0u16, 0u16, key, Match::All),
+                            vel,
+                        )),
+                        Send::Off(key) => evs.push(&NoteOffEvent::new(
+                            time,
+                            Pckn::new(0u16, 0u16, key, Match::All),
+                            0.0,
+                        )),
+                        Send::Param(id, value) => evs.push(&ParamValueEvent::new(
+                            time,
+                            param_id(id),
+                            Pckn::match_all(),
+                            value,
+                        )),
+                    }
+                }
+                let mut inp: [Vec<f32>; 2] = match input {
+                    Some(x) => [
+                        x[0][start..start + n].to_vec(),
+                        x[1][start..start + n].to_vec(),
+                    ],
+                    None => [vec![0.0; n], vec![0.0; n]],
+                };
+                let mut out = [vec![0.0f32; n], vec![0.0f32; n]];
+                let input_audio = in_ports.with_input_buffers([AudioPortBuffer {
+                    latency: 0,
+                    channels: AudioPortBufferType::f32_input_only(
+                        inp.iter_mut()
+                            .map(|b| InputChannel::constant(b.as_mut_slice())),
+                    ),
+                }]);
+                let mut output_audio = out_ports.with_output_buffers([AudioPortBuffer {
+                    latency: 0,
+                    channels: AudioPortBufferType::f32_output_only(
+                        out.iter_mut().map(|b| b.as_mut_slice()),
+                    ),
+                }]);
+                out_events.clear();
+                p.process(
+                    &input_audio,
+                    &mut output_audio,
+                    &evs.as_input(),
+                    &mut out_events.as_output(),
+                    None,
+                    None,
+                )
+                .expect("process succeeds");
+                left.extend_from_slice(&out[0]);
+                right.extend_from_slice(&out[1]);
+                start += n;
+            }
+            p.stop_processing()
+        })
+        .join()
+        .unwrap()
+    });
+    if instance.access_shared_handler(|h| h.callback_requested.swap(false, Ordering::SeqCst)) {
+        instance.call_on_main_thread_callback();
+    }
+    let mut saved = Vec::new();
+    state_ext
+        .save(&mut instance.plugin_handle(), &mut saved)
+        .expect("state saves");
+    instance.deactivate(processor);
+    Session {
+        left,
+        right,
+        state: saved,
+    }
+}
+
+#[test]
+fn the_bundle_offers_the_instrument_and_the_effect() {
+    // SAFETY: as above.
+    let entry = unsafe { PluginEntry::load(bundle()) }.unwrap();
+    let factory = entry.get_plugin_factory().unwrap();
+    let found: Vec<(String, Vec<String>)> = factory
+        .plugin_descriptors()
+        .map(|d| {
+            let id = d.id().unwrap().to_string_lossy().into_owned();
+            (
+                id,
+                d.features()
+                    .map(|f| f.to_string_lossy().into_owned())
+                    .collect(),
+            )
+        })
+        .collect();
+    let features = |id: &str| {
+        found
+            .iter()
+            .find(|(i, _)| i == id)
+            .map(|(_, f)| f.clone())
+            .unwrap_or_default()
+    };
+    assert!(
+        features("org.modal-resonator.instrument").contains(&"instrument".to_string()),
+        "{found:?}"
+    );
+    assert!(
+        features("org.modal-resonator.effect").contains(&"audio-effect".to_string()),
+        "{found:?}"
+    );
+}
+
+#[test]
+fn notes_sound_at_their_pitch_and_level_on_their_sample() {
+    // The default bank (a marimba bar rooted at C4) played at A4.
+    let s = session(
+        INSTRUMENT,
+        None,
+        &[(1_000, Send::On(69, 1.0))],
+        None,
+        48_000,
+    );
+    let first = s.left.iter().position(|&v| v != 0.0).expect("sound");
+    assert_eq!(
+        first, 1_001,
+        "the note starts on its own sample (sounding from the next)"
+    );
+    let level = peak(&s.left).max(peak(&s.right));
+    assert!(level > 0.06 && level < 1.0, "peak {level}");
+    let got = pitch_hz(&s.left[1_100..], RATE, 300.0, 600.0);
+    assert!((got / 440.0 - 1.0).abs() < 0.005, "A4 played at {got} Hz");
+    assert!(s.left.iter().chain(&s.right).all(|v| v.is_finite()));
+
+    // With full release damping, a note-off silences the note within 100 ms.
+    let events = [
+        (0, Send::Param("reldmp", 1.0)),
+        (1_000, Send::On(69, 1.0)),
+        (12_000, Send::Off(69)),
+    ];
+    let s = session(INSTRUMENT, None, &events, None, 24_000);
+    assert!(
+        peak(&s.left[6_000..12_000]) > 0.01,
+        "sounding before the note-off"
+    );
+    assert!(
+        peak(&s.left[16_800..]) < 1e-3,
+        "still sounding 100 ms after the note-off: {}",
+        peak(&s.left[16_800..])
+    );
+}
+
+#[test]
+fn state_round_trips_with_the_bank_in_it() {
+    // Save a state, put a one-mode bank at 1 kHz into it, and play it in a fresh instance.
+    let first = session(INSTRUMENT, None, &[], None, BLOCK);
+    let text = String::from_utf8(first.state[8..].to_vec()).unwrap();
+    let mut state: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let bank = common::simple_bank(&[(1_000.0, 3.0, 1.0)]);
+    let bank_json = modal_resonator::model::io::bank_to_json(&{
+        let mut b = bank;
+        b.root_hz = Some(1_000.0);
+        b
+    });
+    state["fields"]["bank"] = serde_json::Value::String(serde_json::to_string(&bank_json).unwrap());
+    let text = serde_json::to_string(&state).unwrap();
+    let mut bytes = (text.len() as u64).to_le_bytes().to_vec();
+    bytes.extend_from_slice(text.as_bytes());
+
+    // Key 83 is B5; root 1 kHz is key 83.21, so B5 plays 1 kHz * 2^(-0.21/12).
+    let s = session(
+        INSTRUMENT,
+        Some(&bytes),
+        &[(0, Send::On(83, 1.0))],
+        None,
+        24_000,
+    );
+    let want =
+        1_000.0 * 2f64.powf((83.0 - modal_resonator::dsp::coeffs::hz_to_midi_key(1_000.0)) / 12.0);
+    let got = pitch_hz(&s.left[10..], RATE, 700.0, 1_400.0);
+    assert!(
+        (got / want - 1.0).abs() < 0.003,
+        "restored bank plays {got} Hz, want {want}"
+    );
+    // Saving again keeps the bank and every parameter.
+    let again: serde_json::Value = serde_json::from_slice(&s.state[8..]).unwrap();
+    assert_eq!(again["fields"]["bank"], state["fields"]["bank"]);
+    assert_eq!(again["params"], state["params"]);
+}
+
+#[test]
+fn a_broken_bank_in_the_state_keeps_a_bank_playing() {
+    let first = session(INSTRUMENT, None, &[], None, BLOCK);
+    let mut state: serde_json::Value = serde_json::from_slice(&first.state[8..]).unwrap();
+    state["fields"]["bank"] = serde_json::Value::String(
+        serde_json::to_string("{\"format\": \"modal-bank\", \"version\": 7}").unwrap(),
+    );
+    let text = serde_json::to_string(&state).unwrap();
+    let mut bytes = (text.len() as u64).to_le_bytes().to_vec();
+    bytes.extend_from_slice(text.as_bytes());
+    let s = session(
+        INSTRUMENT,
+        Some(&bytes),
+        &[(0, Send::On(60, 1.0))],
+        None,
+        12_000,
+    );
+    assert!(
+        peak(&s.left) > 0.1,
+        "the instrument went silent on a broken bank"
+    );
+}
+
+#[test]
+fn the_exciter_input_drives_the_modes_in_direct_mode() {
+    // A click train into the "Exciter" port, input mode "direct" (enum index 1).
+    let clicks: Vec<f32> = (0..24_000)
+        .map(|i| if i % 4_800 == 100 { 0.5 } else { 0.0 })
+        .collect();
+    let input = [clicks.clone(), clicks];
+    let off = session(INSTRUMENT, None, &[], Some(&input), 24_000);
+    assert_eq!(peak(&off.left), 0.0, "input mode off ignores the exciter");
+    let direct = session(
+        INSTRUMENT,
+        None,
+        &[(0, Send::Param("inmode", 1.0))],
+        Some(&input),
+        24_000,
+    );
+    assert!(
+        peak(&direct.left) > 0.01,
+        "the exciter did not ring the object: {}",
+        peak(&direct.left)
+    );
+}
+
+#[test]
+fn the_effect_rings_its_input_and_mixes_it_dry() {
+    let mut seed = 7u32;
+    let noise: Vec<f32> = (0..24_000)
+        .map(|i| {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            if i < 2_400 {
+                (seed as f32 / u32::MAX as f32 - 0.5) * 0.5
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let input = [noise.clone(), noise.clone()];
+    // Fully dry: the input passes unchanged.
+    let dry = session(
+        EFFECT,
+        None,
+        &[(0, Send::Param("mix", 0.0))],
+        Some(&input),
+        24_000,
+    );
+    for (i, (a, b)) in dry.left.iter().zip(&noise).enumerate() {
+        assert!((a - b).abs() < 1e-6, "dry sample {i}: {a} vs {b}");
+    }
+    // Fully wet: the resonators ring on after the noise stops.
+    let wet = session(
+        EFFECT,
+        None,
+        &[(0, Send::Param("mix", 1.0))],
+        Some(&input),
+        24_000,
+    );
+    assert!(
+        peak(&wet.left[4_800..]) > 1e-3,
+        "no ringing after the input: {}",
+        peak(&wet.left[4_800..])
+    );
+}
