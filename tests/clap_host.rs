@@ -9,7 +9,7 @@ mod common;
 use std::ffi::CStr;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::OnceLock;
+use std::sync::{Mutex, OnceLock};
 
 use clack_extensions::state::PluginState;
 use clack_host::events::event_types::*;
@@ -63,6 +63,17 @@ fn bundle() -> PathBuf {
     path
 }
 
+/// The bundle, loaded once for the whole test process: loading and unloading a plugin library
+/// from several threads at once is not something hosts do.
+fn entry() -> &'static PluginEntry {
+    static ENTRY: OnceLock<PluginEntry> = OnceLock::new();
+    // SAFETY: the bundle is our own plugin, built for this machine.
+    ENTRY.get_or_init(|| unsafe { PluginEntry::load(bundle()) }.expect("the bundle loads"))
+}
+
+/// Held by each session: one plugin instance at a time, as in a host's test of one track.
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
 /// The CLAP parameter id nice-plug derives from a parameter's string id.
 fn param_id(id: &str) -> ClapId {
     let mut hash: u32 = 0;
@@ -97,6 +108,7 @@ fn session(
     input: Option<&[Vec<f32>; 2]>,
     samples: usize,
 ) -> Session {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let host_info = HostInfo::new(
         "modal-resonator-tests",
         "Modal Resonator",
@@ -104,15 +116,13 @@ fn session(
         "0.1.0",
     )
     .unwrap();
-    // SAFETY: the bundle is our own plugin, built for this machine.
-    let entry = unsafe { PluginEntry::load(bundle()) }.expect("the bundle loads");
     let mut instance = PluginInstance::<Host>::new(
         |_| Shared {
             state_ext: OnceLock::new(),
             callback_requested: AtomicBool::new(false),
         },
         |_| (),
-        &entry,
+        entry(),
         plugin,
         &host_info,
     )
@@ -123,7 +133,7 @@ fn session(
     if let Some(bytes) = state {
         state_ext
             .load(
-                &mut instance.plugin_handle(),
+                &instance.plugin_handle(),
                 &mut std::io::Cursor::new(bytes.to_vec()),
             )
             .expect("state loads");
@@ -217,7 +227,7 @@ fn session(
     }
     let mut saved = Vec::new();
     state_ext
-        .save(&mut instance.plugin_handle(), &mut saved)
+        .save(&instance.plugin_handle(), &mut saved)
         .expect("state saves");
     instance.deactivate(processor);
     Session {
@@ -229,9 +239,7 @@ fn session(
 
 #[test]
 fn the_bundle_offers_the_instrument_and_the_effect() {
-    // SAFETY: as above.
-    let entry = unsafe { PluginEntry::load(bundle()) }.unwrap();
-    let factory = entry.get_plugin_factory().unwrap();
+    let factory = entry().get_plugin_factory().unwrap();
     let found: Vec<(String, Vec<String>)> = factory
         .plugin_descriptors()
         .map(|d| {
