@@ -45,8 +45,18 @@ impl HostHandlers for Host {
     type AudioProcessor<'a> = ();
 }
 
-/// The CLAP bundle built by `cargo xtask bundle`, next to this test's target directory.
-fn bundle() -> PathBuf {
+/// Which built bundle a test loads.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Build {
+    /// `cargo xtask bundle modal-resonator --release`, in `target/bundled`.
+    Release,
+    /// `CARGO_TARGET_DIR=target/alloc-check cargo xtask bundle modal-resonator --features
+    /// assert_process_allocs`: a debug build that aborts on any allocation in `process`.
+    AllocCheck,
+}
+
+/// The path of a built CLAP bundle, found from this test's own target directory.
+fn bundle(build: Build) -> PathBuf {
     let exe = std::env::current_exe().unwrap();
     // target/<profile>/deps/<test> -> target
     let target = exe
@@ -54,21 +64,34 @@ fn bundle() -> PathBuf {
         .and_then(|p| p.parent())
         .and_then(|p| p.parent())
         .unwrap();
-    let path = target.join("bundled").join("Modal Resonator.clap");
+    let (dir, how) = match build {
+        Build::Release => (target.to_path_buf(), "cargo xtask bundle modal-resonator --release"),
+        Build::AllocCheck => (
+            target.join("alloc-check"),
+            "CARGO_TARGET_DIR=target/alloc-check cargo xtask bundle modal-resonator --features assert_process_allocs",
+        ),
+    };
+    let path = dir.join("bundled").join("Modal Resonator.clap");
     assert!(
         path.exists(),
-        "{} is missing: run `cargo xtask bundle modal-resonator --release` first",
+        "{} is missing: run `{how}` first",
         path.display()
     );
     path
 }
 
-/// The bundle, loaded once for the whole test process: loading and unloading a plugin library
+/// A bundle, loaded once for the whole test process: loading and unloading a plugin library
 /// from several threads at once is not something hosts do.
-fn entry() -> &'static PluginEntry {
-    static ENTRY: OnceLock<PluginEntry> = OnceLock::new();
+fn entry(build: Build) -> &'static PluginEntry {
+    static RELEASE: OnceLock<PluginEntry> = OnceLock::new();
+    static ALLOC_CHECK: OnceLock<PluginEntry> = OnceLock::new();
+    let cell = if build == Build::Release {
+        &RELEASE
+    } else {
+        &ALLOC_CHECK
+    };
     // SAFETY: the bundle is our own plugin, built for this machine.
-    ENTRY.get_or_init(|| unsafe { PluginEntry::load(bundle()) }.expect("the bundle loads"))
+    cell.get_or_init(|| unsafe { PluginEntry::load(bundle(build)) }.expect("the bundle loads"))
 }
 
 /// Held by each session: one plugin instance at a time, as in a host's test of one track.
@@ -99,6 +122,38 @@ struct Session {
     state: Vec<u8>,
 }
 
+/// What a session plays.
+struct Script<'a> {
+    /// Which bundle.
+    build: Build,
+    /// Which plugin in it.
+    plugin: &'a CStr,
+    /// A state restored before activation.
+    state: Option<&'a [u8]>,
+    /// Events at absolute sample times.
+    events: &'a [(usize, Send)],
+    /// Audio on the input port.
+    input: Option<&'a [Vec<f32>; 2]>,
+    /// Samples to render.
+    samples: usize,
+    /// A state loaded while active, between blocks, at this sample: a bank swap.
+    swap: Option<(usize, &'a [u8])>,
+}
+
+impl<'a> Script<'a> {
+    fn new(plugin: &'a CStr, samples: usize) -> Self {
+        Self {
+            build: Build::Release,
+            plugin,
+            state: None,
+            events: &[],
+            input: None,
+            samples,
+            swap: None,
+        }
+    }
+}
+
 /// Loads `plugin` from the bundle, restores `state` if given, activates at 48 kHz, plays `events`
 /// with `input` on the input port, renders `samples` samples, saves the state and returns.
 fn session(
@@ -108,57 +163,34 @@ fn session(
     input: Option<&[Vec<f32>; 2]>,
     samples: usize,
 ) -> Session {
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let host_info = HostInfo::new(
-        "modal-resonator-tests",
-        "Modal Resonator",
-        "https://modal-resonator.org",
-        "0.1.0",
-    )
-    .unwrap();
-    let mut instance = PluginInstance::<Host>::new(
-        |_| Shared {
-            state_ext: OnceLock::new(),
-            callback_requested: AtomicBool::new(false),
-        },
-        |_| (),
-        entry(),
-        plugin,
-        &host_info,
-    )
-    .expect("the plugin instantiates");
-    let state_ext = instance
-        .access_shared_handler(|h| *h.state_ext.get().unwrap())
-        .expect("state extension");
-    if let Some(bytes) = state {
-        state_ext
-            .load(
-                &instance.plugin_handle(),
-                &mut std::io::Cursor::new(bytes.to_vec()),
-            )
-            .expect("state loads");
-    }
-    let config = PluginAudioConfiguration {
-        sample_rate: RATE,
-        min_frames_count: 1,
-        max_frames_count: BLOCK as u32,
-    };
-    let processor = instance
-        .activate(|_, _| (), config)
-        .expect("the plugin activates");
-    let mut left = Vec::with_capacity(samples);
-    let mut right = Vec::with_capacity(samples);
-    let processor = std::thread::scope(|s| {
+    run(&Script {
+        state,
+        events,
+        input,
+        ..Script::new(plugin, samples)
+    })
+}
+
+/// Renders `from..to` of `script` on an audio thread of its own.
+fn render_span(
+    script: &Script,
+    processor: StoppedPluginAudioProcessor<Host>,
+    span: std::ops::Range<usize>,
+    left: &mut Vec<f32>,
+    right: &mut Vec<f32>,
+) -> StoppedPluginAudioProcessor<Host> {
+    std::thread::scope(|s| {
         s.spawn(|| {
             let mut p = processor.start_processing().unwrap();
             let mut in_ports = AudioPorts::with_capacity(2, 1);
             let mut out_ports = AudioPorts::with_capacity(2, 1);
             let mut out_events = EventBuffer::new();
-            let mut start = 0;
-            while start < samples {
-                let n = BLOCK.min(samples - start);
+            let mut start = span.start;
+            while start < span.end {
+                let n = BLOCK.min(span.end - start);
                 let mut evs = EventBuffer::new();
-                for &(t, e) in events
+                for &(t, e) in script
+                    .events
                     .iter()
                     .filter(|(t, _)| (start..start + n).contains(t))
                 {
@@ -182,7 +214,7 @@ fn session(
                         )),
                     }
                 }
-                let mut inp: [Vec<f32>; 2] = match input {
+                let mut inp: [Vec<f32>; 2] = match script.input {
                     Some(x) => [
                         x[0][start..start + n].to_vec(),
                         x[1][start..start + n].to_vec(),
@@ -216,12 +248,82 @@ fn session(
                 left.extend_from_slice(&out[0]);
                 right.extend_from_slice(&out[1]);
                 start += n;
+                if script
+                    .swap
+                    .is_some_and(|(at, _)| start >= at && start < at + 64 * BLOCK)
+                {
+                    // Give the background thread time to build the new bank's engine.
+                    std::thread::sleep(std::time::Duration::from_millis(2));
+                }
             }
             p.stop_processing()
         })
         .join()
         .unwrap()
-    });
+    })
+}
+
+/// Plays `script` in a fresh instance.
+fn run(script: &Script) -> Session {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let host_info = HostInfo::new(
+        "modal-resonator-tests",
+        "Modal Resonator",
+        "https://modal-resonator.org",
+        "0.1.0",
+    )
+    .unwrap();
+    let mut instance = PluginInstance::<Host>::new(
+        |_| Shared {
+            state_ext: OnceLock::new(),
+            callback_requested: AtomicBool::new(false),
+        },
+        |_| (),
+        entry(script.build),
+        script.plugin,
+        &host_info,
+    )
+    .expect("the plugin instantiates");
+    let state_ext = instance
+        .access_shared_handler(|h| *h.state_ext.get().unwrap())
+        .expect("state extension");
+    if let Some(bytes) = script.state {
+        state_ext
+            .load(
+                &instance.plugin_handle(),
+                &mut std::io::Cursor::new(bytes.to_vec()),
+            )
+            .expect("state loads");
+    }
+    let config = PluginAudioConfiguration {
+        sample_rate: RATE,
+        min_frames_count: 1,
+        max_frames_count: BLOCK as u32,
+    };
+    let mut processor = instance
+        .activate(|_, _| (), config)
+        .expect("the plugin activates");
+    let mut left = Vec::with_capacity(script.samples);
+    let mut right = Vec::with_capacity(script.samples);
+    let swap_at = script
+        .swap
+        .map_or(script.samples, |(at, _)| at.min(script.samples));
+    processor = render_span(script, processor, 0..swap_at, &mut left, &mut right);
+    if let Some((_, bytes)) = script.swap {
+        state_ext
+            .load(
+                &instance.plugin_handle(),
+                &mut std::io::Cursor::new(bytes.to_vec()),
+            )
+            .expect("state loads");
+        processor = render_span(
+            script,
+            processor,
+            swap_at..script.samples,
+            &mut left,
+            &mut right,
+        );
+    }
     if instance.access_shared_handler(|h| h.callback_requested.swap(false, Ordering::SeqCst)) {
         instance.call_on_main_thread_callback();
     }
@@ -237,9 +339,27 @@ fn session(
     }
 }
 
+/// `state` (a saved CLAP state: length, then JSON) with `bank` as its saved bank.
+fn with_bank(state: &[u8], bank: &modal_resonator::model::Bank) -> Vec<u8> {
+    let mut json: serde_json::Value = serde_json::from_slice(&state[8..]).unwrap();
+    let bank_json = modal_resonator::model::io::bank_to_json(bank);
+    json["fields"]["bank"] = serde_json::Value::String(serde_json::to_string(&bank_json).unwrap());
+    let text = serde_json::to_string(&json).unwrap();
+    let mut bytes = (text.len() as u64).to_le_bytes().to_vec();
+    bytes.extend_from_slice(text.as_bytes());
+    bytes
+}
+
+/// A one-mode bank at `freq_hz`, rooted there.
+fn sine_bank(freq_hz: f64) -> modal_resonator::model::Bank {
+    let mut bank = common::simple_bank(&[(freq_hz, 3.0, 1.0)]);
+    bank.root_hz = Some(freq_hz);
+    bank
+}
+
 #[test]
 fn the_bundle_offers_the_instrument_and_the_effect() {
-    let factory = entry().get_plugin_factory().unwrap();
+    let factory = entry(Build::Release).get_plugin_factory().unwrap();
     let found: Vec<(String, Vec<String>)> = factory
         .plugin_descriptors()
         .map(|d| {
@@ -312,19 +432,7 @@ fn notes_sound_at_their_pitch_and_level_on_their_sample() {
 fn state_round_trips_with_the_bank_in_it() {
     // Save a state, put a one-mode bank at 1 kHz into it, and play it in a fresh instance.
     let first = session(INSTRUMENT, None, &[], None, BLOCK);
-    let text = String::from_utf8(first.state[8..].to_vec()).unwrap();
-    let mut state: serde_json::Value = serde_json::from_str(&text).unwrap();
-    let bank = common::simple_bank(&[(1_000.0, 3.0, 1.0)]);
-    let bank_json = modal_resonator::model::io::bank_to_json(&{
-        let mut b = bank;
-        b.root_hz = Some(1_000.0);
-        b
-    });
-    state["fields"]["bank"] = serde_json::Value::String(serde_json::to_string(&bank_json).unwrap());
-    let text = serde_json::to_string(&state).unwrap();
-    let mut bytes = (text.len() as u64).to_le_bytes().to_vec();
-    bytes.extend_from_slice(text.as_bytes());
-
+    let bytes = with_bank(&first.state, &sine_bank(1_000.0));
     // Key 83 is B5; root 1 kHz is key 83.21, so B5 plays 1 kHz * 2^(-0.21/12).
     let s = session(
         INSTRUMENT,
@@ -342,8 +450,101 @@ fn state_round_trips_with_the_bank_in_it() {
     );
     // Saving again keeps the bank and every parameter.
     let again: serde_json::Value = serde_json::from_slice(&s.state[8..]).unwrap();
-    assert_eq!(again["fields"]["bank"], state["fields"]["bank"]);
-    assert_eq!(again["params"], state["params"]);
+    let loaded: serde_json::Value = serde_json::from_slice(&bytes[8..]).unwrap();
+    assert_eq!(again["fields"]["bank"], loaded["fields"]["bank"]);
+    assert_eq!(again["params"], loaded["params"]);
+}
+
+#[test]
+fn a_bank_loaded_while_playing_takes_over_without_a_gap() {
+    let first = session(INSTRUMENT, None, &[], None, BLOCK);
+    let bytes = with_bank(&first.state, &sine_bank(1_000.0));
+    // Notes on A4 every 0.1 s; the 1 kHz bank arrives at 0.5 s.
+    let notes: Vec<(usize, Send)> = (0..20).map(|i| (i * 4_800, Send::On(69, 1.0))).collect();
+    let s = run(&Script {
+        events: &notes,
+        swap: Some((24_000, &bytes)),
+        ..Script::new(INSTRUMENT, 96_000)
+    });
+    let before = pitch_hz(&s.left[4_900..9_500], RATE, 300.0, 600.0);
+    assert!(
+        (before / 440.0 - 1.0).abs() < 0.005,
+        "before the swap: {before} Hz"
+    );
+    // By the last note the new bank plays: key 69 on a bank rooted at 1 kHz (key 83.21).
+    let want =
+        1_000.0 * 2f64.powf((69.0 - modal_resonator::dsp::coeffs::hz_to_midi_key(1_000.0)) / 12.0);
+    let after = pitch_hz(&s.left[91_300..95_900], RATE, 300.0, 600.0);
+    assert!(
+        (after / want - 1.0).abs() < 0.005,
+        "after the swap: {after} Hz, want {want}"
+    );
+    // Every note still sounded: no block of silence while the new bank was built.
+    for i in 0..20 {
+        let note = &s.left[i * 4_800 + 10..i * 4_800 + 2_000];
+        assert!(peak(note) > 0.01, "note {i} is silent");
+    }
+}
+
+/// The parameter ids of the plugins, as in `src/params.rs`.
+const PARAM_IDS: &[&str] = &[
+    "mat", "q", "tilt", "size", "keytrk", "fine", "bendrg", "posx", "posy", "posvar", "exc",
+    "hard", "velsns", "velhrd", "reldmp", "trunc", "poly", "width", "gain", "inmode", "ingain",
+    "trigth", "retrig", "mix", "modwhl", "press",
+];
+
+#[test]
+fn process_never_allocates_through_storms_sweeps_and_bank_swaps() {
+    // The debug bundle built with assert_process_allocs aborts the whole process on any
+    // allocation or free inside `process`: surviving this session is the proof.
+    let notes_per_block = 48;
+    let blocks = 160;
+    let mut events = Vec::new();
+    for b in 0..blocks {
+        let t0 = b * BLOCK;
+        for i in 0..notes_per_block {
+            let key = ((b * 7 + i * 13) % 88 + 21) as u16;
+            let t = t0 + (i * 5) % BLOCK;
+            events.push((
+                t,
+                if i % 4 == 3 {
+                    Send::Off(key)
+                } else {
+                    Send::On(key, (i % 10) as f64 / 9.0 + 0.05)
+                },
+            ));
+        }
+        for (k, id) in PARAM_IDS.iter().enumerate() {
+            // Sweep each parameter through its range, enums through their first entries.
+            let phase = ((b + k * 5) % 40) as f64 / 39.0;
+            let value = match *id {
+                "mat" => ((b + k) % 7) as f64,
+                "exc" | "inmode" | "modwhl" | "press" => ((b + k) % 3) as f64,
+                _ => phase,
+            };
+            events.push((t0 + (k * 3) % BLOCK, Send::Param(id, value)));
+        }
+    }
+    events.sort_by_key(|(t, _)| *t);
+    let first = run(&Script {
+        build: Build::AllocCheck,
+        ..Script::new(INSTRUMENT, BLOCK)
+    });
+    let bytes = with_bank(&first.state, &sine_bank(700.0));
+    let noise: Vec<f32> = (0..blocks * BLOCK)
+        .map(|i| ((i * 7_919) % 1_000) as f32 / 4_000.0 - 0.125)
+        .collect();
+    let input = [noise.clone(), noise];
+    let s = run(&Script {
+        build: Build::AllocCheck,
+        events: &events,
+        input: Some(&input),
+        swap: Some((blocks * BLOCK / 2, &bytes)),
+        ..Script::new(INSTRUMENT, blocks * BLOCK)
+    });
+    assert_eq!(s.left.len(), blocks * BLOCK);
+    assert!(s.left.iter().chain(&s.right).all(|v| v.is_finite()));
+    assert!(peak(&s.left) > 0.0);
 }
 
 #[test]
