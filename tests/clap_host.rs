@@ -113,6 +113,8 @@ enum Send {
     Off(u16),
     /// A parameter by string id, in CLAP's value (normalised 0..1, or the index of an enum).
     Param(&'static str, f64),
+    /// A raw MIDI message on port 0.
+    Midi([u8; 3]),
 }
 
 /// What one session with a plugin produced.
@@ -138,6 +140,10 @@ struct Script<'a> {
     samples: usize,
     /// A state loaded while active, between blocks, at this sample: a bank swap.
     swap: Option<(usize, &'a [u8])>,
+    /// Sample rate in Hz.
+    rate: f64,
+    /// Block sizes, used in turn.
+    blocks: &'a [usize],
 }
 
 impl<'a> Script<'a> {
@@ -150,6 +156,8 @@ impl<'a> Script<'a> {
             input: None,
             samples,
             swap: None,
+            rate: RATE,
+            blocks: &[BLOCK],
         }
     }
 }
@@ -186,8 +194,10 @@ fn render_span(
             let mut out_ports = AudioPorts::with_capacity(2, 1);
             let mut out_events = EventBuffer::new();
             let mut start = span.start;
+            let mut block = 0;
             while start < span.end {
-                let n = BLOCK.min(span.end - start);
+                let n = script.blocks[block % script.blocks.len()].min(span.end - start);
+                block += 1;
                 let mut evs = EventBuffer::new();
                 for &(t, e) in script
                     .events
@@ -212,6 +222,7 @@ fn render_span(
                             Pckn::match_all(),
                             value,
                         )),
+                        Send::Midi(bytes) => evs.push(&MidiEvent::new(time, 0, bytes)),
                     }
                 }
                 let mut inp: [Vec<f32>; 2] = match script.input {
@@ -295,10 +306,11 @@ fn run(script: &Script) -> Session {
             )
             .expect("state loads");
     }
+    let max_block = script.blocks.iter().copied().max().unwrap_or(BLOCK);
     let config = PluginAudioConfiguration {
-        sample_rate: RATE,
+        sample_rate: script.rate,
         min_frames_count: 1,
-        max_frames_count: BLOCK as u32,
+        max_frames_count: max_block as u32,
     };
     let mut processor = instance
         .activate(|_, _| (), config)
@@ -633,4 +645,82 @@ fn the_effect_rings_its_input_and_mixes_it_dry() {
         "no ringing after the input: {}",
         peak(&wet.left[4_800..])
     );
+}
+
+#[test]
+fn any_rate_and_any_block_size_give_the_same_note() {
+    // Blocks from 1 to 8192 samples at 44.1 and 192 kHz: the note keeps its pitch and timing,
+    // and the output does not depend on how the host cuts the stream.
+    for rate in [44_100.0, 192_000.0] {
+        let samples = (rate * 0.5) as usize;
+        let at = (rate * 0.1) as usize;
+        let events = [(at, Send::On(69, 1.0))];
+        let steady = run(&Script {
+            rate,
+            events: &events,
+            blocks: &[512],
+            ..Script::new(INSTRUMENT, samples)
+        });
+        let varied = run(&Script {
+            rate,
+            events: &events,
+            blocks: &[1, 8192, 7, 64, 333, 4096],
+            ..Script::new(INSTRUMENT, samples)
+        });
+        assert!(
+            steady.left == varied.left,
+            "{rate} Hz: block sizes changed the output"
+        );
+        assert_eq!(
+            varied.left.iter().position(|&v| v != 0.0),
+            Some(at + 1),
+            "{rate} Hz: note timing"
+        );
+        let got = pitch_hz(&varied.left[at + 10..], rate, 300.0, 600.0);
+        assert!(
+            (got / 440.0 - 1.0).abs() < 0.005,
+            "{rate} Hz: A4 at {got} Hz"
+        );
+    }
+}
+
+#[test]
+fn taps_on_the_exciter_strike_in_trigger_mode() {
+    // Three taps into the exciter input, input mode "trigger" (enum index 2).
+    let taps: Vec<f32> = (0..48_000)
+        .map(|i| {
+            let t = i % 16_000;
+            if (4_000..4_400).contains(&t) {
+                let sign = if t % 2 == 0 { 1.0 } else { -1.0 };
+                0.6 * (-((t - 4_000) as f32) / 60.0).exp() * sign
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let input = [taps.clone(), taps];
+    let s = run(&Script {
+        events: &[(0, Send::Param("inmode", 2.0))],
+        input: Some(&input),
+        ..Script::new(INSTRUMENT, 48_000)
+    });
+    assert_eq!(peak(&s.left[..4_000]), 0.0, "nothing before the first tap");
+    for k in 0..3 {
+        let start = k * 16_000 + 4_000;
+        assert!(
+            peak(&s.left[start..start + 4_000]) > 0.01,
+            "tap {k} did not strike"
+        );
+    }
+}
+
+#[test]
+fn all_sound_off_silences_at_once() {
+    // MIDI CC 120 (all sound off) through the host: silence right after it.
+    let s = run(&Script {
+        events: &[(0, Send::On(60, 1.0)), (12_000, Send::Midi([0xB0, 120, 0]))],
+        ..Script::new(INSTRUMENT, 24_000)
+    });
+    assert!(peak(&s.left[..12_000]) > 0.05);
+    assert_eq!(peak(&s.left[12_001..]), 0.0, "sound after CC 120");
 }
