@@ -59,7 +59,7 @@ fn mode_samples_per_s(kernel: Kernel, num_modes: usize, work: usize, driven: boo
 
 /// Real-time factor of the engine; with `sweep`, the pitch bend moves every block so every voice
 /// recomputes its coefficients on every control tick.
-fn engine_realtime_factor(kernel: Kernel, sweep: bool) -> (f64, usize) {
+fn engine_realtime_factor(kernel: Kernel, sweep: bool, seconds: f64) -> (f64, usize) {
     let positions = vec![Position {
         name: "a".into(),
         coords: vec![0.0],
@@ -74,7 +74,6 @@ fn engine_realtime_factor(kernel: Kernel, sweep: bool) -> (f64, usize) {
         .collect();
     bank.root_hz = Some(60.0);
     let prepared = Arc::new(PreparedBank::new(&bank));
-    let seconds = 10.0;
     let mut best = f64::INFINITY;
     let mut live = 0;
     for _ in 0..REPEATS {
@@ -114,6 +113,8 @@ fn main() {
     // `cargo test --benches` runs this with --bench absent; keep that quick.
     let quick = !std::env::args().any(|a| a == "--bench");
     let work = if quick { WORK >> 8 } else { WORK };
+    // Seconds of audio per engine case.
+    let engine_seconds = if quick { 0.2 } else { 10.0 };
     let kernels: Vec<Kernel> = Kernel::ALL
         .into_iter()
         .filter(|k| k.is_supported())
@@ -163,8 +164,8 @@ fn main() {
     println!();
     println!("Engine, 16 voices x 256 modes, 48 kHz, {BLOCK}-sample blocks:");
     for &k in &kernels {
-        let (rt, live) = engine_realtime_factor(k, false);
-        let (rt_sweep, _) = engine_realtime_factor(k, true);
+        let (rt, live) = engine_realtime_factor(k, false, engine_seconds);
+        let (rt_sweep, _) = engine_realtime_factor(k, true, engine_seconds);
         println!(
             "  {:<10} real-time factor {:>8.1}x, with pitch bend moving every block {:>8.1}x  ({live} live modes)",
             k.name(),
