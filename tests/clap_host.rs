@@ -122,6 +122,8 @@ struct Session {
     left: Vec<f32>,
     right: Vec<f32>,
     state: Vec<u8>,
+    /// What the plugin answered after each block: whether it may be put to sleep.
+    statuses: Vec<ProcessStatus>,
 }
 
 /// What a session plays.
@@ -186,6 +188,7 @@ fn render_span(
     span: std::ops::Range<usize>,
     left: &mut Vec<f32>,
     right: &mut Vec<f32>,
+    statuses: &mut Vec<ProcessStatus>,
 ) -> StoppedPluginAudioProcessor<Host> {
     std::thread::scope(|s| {
         s.spawn(|| {
@@ -247,15 +250,17 @@ fn render_span(
                     ),
                 }]);
                 out_events.clear();
-                p.process(
-                    &input_audio,
-                    &mut output_audio,
-                    &evs.as_input(),
-                    &mut out_events.as_output(),
-                    None,
-                    None,
-                )
-                .expect("process succeeds");
+                let status = p
+                    .process(
+                        &input_audio,
+                        &mut output_audio,
+                        &evs.as_input(),
+                        &mut out_events.as_output(),
+                        None,
+                        None,
+                    )
+                    .expect("process succeeds");
+                statuses.push(status);
                 left.extend_from_slice(&out[0]);
                 right.extend_from_slice(&out[1]);
                 start += n;
@@ -317,10 +322,18 @@ fn run(script: &Script) -> Session {
         .expect("the plugin activates");
     let mut left = Vec::with_capacity(script.samples);
     let mut right = Vec::with_capacity(script.samples);
+    let mut statuses = Vec::new();
     let swap_at = script
         .swap
         .map_or(script.samples, |(at, _)| at.min(script.samples));
-    processor = render_span(script, processor, 0..swap_at, &mut left, &mut right);
+    processor = render_span(
+        script,
+        processor,
+        0..swap_at,
+        &mut left,
+        &mut right,
+        &mut statuses,
+    );
     if let Some((_, bytes)) = script.swap {
         state_ext
             .load(
@@ -334,6 +347,7 @@ fn run(script: &Script) -> Session {
             swap_at..script.samples,
             &mut left,
             &mut right,
+            &mut statuses,
         );
     }
     if instance.access_shared_handler(|h| h.callback_requested.swap(false, Ordering::SeqCst)) {
@@ -348,6 +362,7 @@ fn run(script: &Script) -> Session {
         left,
         right,
         state: saved,
+        statuses,
     }
 }
 
@@ -723,4 +738,45 @@ fn all_sound_off_silences_at_once() {
     });
     assert!(peak(&s.left[..12_000]) > 0.05);
     assert_eq!(peak(&s.left[12_001..]), 0.0, "sound after CC 120");
+}
+
+#[test]
+fn silence_in_gives_silence_out_and_the_plugin_says_it_is_idle() {
+    // A note damped on release: busy while it sounds, idle (may sleep) once it is gone.
+    let events = [
+        (0, Send::Param("reldmp", 1.0)),
+        (0, Send::On(60, 1.0)),
+        (4_800, Send::Off(60)),
+    ];
+    let s = run(&Script {
+        events: &events,
+        ..Script::new(INSTRUMENT, 48_000)
+    });
+    assert_eq!(
+        s.statuses[1],
+        ProcessStatus::Continue,
+        "sounding: keep processing"
+    );
+    let last = *s.statuses.last().unwrap();
+    assert_eq!(
+        last,
+        ProcessStatus::ContinueIfNotQuiet,
+        "after the tail the plugin must report it is idle"
+    );
+    assert_eq!(
+        peak(&s.left[40_000..]),
+        0.0,
+        "silence once the note has gone"
+    );
+    // The effect with silent input: silent output, idle from the start.
+    let silent = [vec![0.0f32; 24_000], vec![0.0f32; 24_000]];
+    let fx = run(&Script {
+        input: Some(&silent),
+        ..Script::new(EFFECT, 24_000)
+    });
+    assert_eq!(peak(&fx.left), 0.0);
+    assert!(fx
+        .statuses
+        .iter()
+        .all(|st| *st == ProcessStatus::ContinueIfNotQuiet));
 }
