@@ -123,9 +123,13 @@ impl<K: Kind> ModalPlugin<K> {
         if self.pending_trash.is_some() {
             return;
         }
+        let rate = f32::from_bits(self.shared.sample_rate_bits.load(Ordering::Acquire));
         while let Ok(loaded) = self.loaded_rx.try_recv() {
-            if loaded.generation != self.requested_generation {
-                // Superseded by a newer request: discard off the audio thread.
+            if loaded.generation != self.requested_generation
+                || loaded.engine.sample_rate_hz() != rate
+            {
+                // Superseded by a newer request, or built before the host changed the sample
+                // rate: discard off the audio thread.
                 if let Err(e) = self.trash_tx.try_send(loaded.engine) {
                     self.pending_trash = Some(e.into_inner());
                     return;
