@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests: banks built in code and small signal measurements.
 #![allow(dead_code)]
 
+pub mod clap;
+
 use std::sync::Arc;
 
 use modal_resonator::engine::{Engine, NoteEvent, PreparedBank};
