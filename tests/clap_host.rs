@@ -406,3 +406,28 @@ fn silence_in_gives_silence_out_and_the_plugin_says_it_is_idle() {
         .iter()
         .all(|st| *st == ProcessStatus::ContinueIfNotQuiet));
 }
+
+#[test]
+fn all_notes_off_releases_every_note() {
+    // MIDI CC 123 with full release damping: the chord dies within 100 ms of it.
+    let events = [
+        (0, Send::Param("reldmp", 1.0)),
+        (0, Send::On(60, 1.0)),
+        (0, Send::On(64, 1.0)),
+        (0, Send::On(67, 1.0)),
+        (12_000, Send::Midi([0xB0, 123, 0])),
+    ];
+    let s = run(&Script {
+        events: &events,
+        ..Script::new(INSTRUMENT, 24_000)
+    });
+    assert!(
+        peak(&s.left[6_000..12_000]) > 0.01,
+        "the chord sounds before CC 123"
+    );
+    assert!(
+        peak(&s.left[16_800..]) < 1e-3,
+        "still sounding 100 ms after CC 123: {}",
+        peak(&s.left[16_800..])
+    );
+}
