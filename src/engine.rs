@@ -40,6 +40,9 @@ pub const CONTROL_PERIOD: usize = 64;
 /// Decay multiplier at full extra damping.
 const MAX_EXTRA_DAMPING: f64 = 20.0;
 
+/// Largest per-note tuning offset, in semitones.
+const MAX_EXPRESSION_SEMITONES: f32 = 48.0;
+
 /// Voices beyond the polyphony limit, used by stolen voices while they fade.
 const FADE_SLOTS: usize = 8;
 
@@ -69,6 +72,21 @@ pub enum NoteEvent {
     AllNotesOff { time: u32 },
     /// Silence every voice at once (MIDI CC 120).
     AllSoundOff { time: u32 },
+    /// Change the sounding note on `key` alone (CLAP note expressions, MPE).
+    Expression {
+        time: u32,
+        key: u8,
+        expression: NoteExpression,
+    },
+}
+
+/// A per-note change.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum NoteExpression {
+    /// Tuning offset in semitones, smoothed like pitch bend.
+    Tuning(f32),
+    /// Pressure 0 to 1: damps the note like a hand pressing on the object.
+    Pressure(f32),
 }
 
 impl NoteEvent {
@@ -78,7 +96,29 @@ impl NoteEvent {
             NoteEvent::On { time, .. }
             | NoteEvent::Off { time, .. }
             | NoteEvent::AllNotesOff { time }
-            | NoteEvent::AllSoundOff { time } => time,
+            | NoteEvent::AllSoundOff { time }
+            | NoteEvent::Expression { time, .. } => time,
+        }
+    }
+
+    /// The same event at sample `time`.
+    pub fn at(self, time: u32) -> Self {
+        match self {
+            NoteEvent::On { key, velocity, .. } => NoteEvent::On {
+                time,
+                key,
+                velocity,
+            },
+            NoteEvent::Off { key, .. } => NoteEvent::Off { time, key },
+            NoteEvent::AllNotesOff { .. } => NoteEvent::AllNotesOff { time },
+            NoteEvent::AllSoundOff { .. } => NoteEvent::AllSoundOff { time },
+            NoteEvent::Expression {
+                key, expression, ..
+            } => NoteEvent::Expression {
+                time,
+                key,
+                expression,
+            },
         }
     }
 }

@@ -224,20 +224,6 @@ fn schedule(notes: &[Note], rate: f64) -> Vec<TimedEvent> {
     events
 }
 
-/// `event` at sample `time` of its block.
-fn at(event: NoteEvent, time: u32) -> NoteEvent {
-    match event {
-        NoteEvent::On { key, velocity, .. } => NoteEvent::On {
-            time,
-            key,
-            velocity,
-        },
-        NoteEvent::Off { key, .. } => NoteEvent::Off { time, key },
-        NoteEvent::AllNotesOff { .. } => NoteEvent::AllNotesOff { time },
-        NoteEvent::AllSoundOff { .. } => NoteEvent::AllSoundOff { time },
-    }
-}
-
 /// Seconds until the longest-ringing mode of `bank` falls below the truncation threshold after a
 /// full strike at the root pitch: an estimate of a note's tail, for progress reports only.
 fn estimated_tail_s(bank: &PreparedBank, controls: &Controls) -> f64 {
@@ -296,7 +282,7 @@ pub fn render(
         let len = (block as u64).min(max_samples - pos);
         block_events.clear();
         while next < events.len() && events[next].sample < pos + len {
-            block_events.push(at(events[next].event, (events[next].sample - pos) as u32));
+            block_events.push(events[next].event.at((events[next].sample - pos) as u32));
             next += 1;
         }
         let start = pos as usize;

@@ -6,6 +6,7 @@
 
 mod common;
 
+use clack_host::events::event_types::NoteExpressionType;
 use clack_host::prelude::*;
 use common::clap::*;
 use common::{peak, pitch_hz};
@@ -429,5 +430,37 @@ fn all_notes_off_releases_every_note() {
         peak(&s.left[16_800..]) < 1e-3,
         "still sounding 100 ms after CC 123: {}",
         peak(&s.left[16_800..])
+    );
+}
+
+#[test]
+fn clap_note_expressions_retune_and_damp_one_note() {
+    let tuned = run(&Script {
+        events: &[
+            (0, Send::On(69, 1.0)),
+            (0, Send::Expression(NoteExpressionType::Tuning, 69, 2.0)),
+        ],
+        ..Script::new(INSTRUMENT, 24_000)
+    });
+    let got = pitch_hz(&tuned.left[2_400..], RATE, 300.0, 700.0);
+    let want = 440.0 * 2f64.powf(2.0 / 12.0);
+    assert!(
+        (got / want - 1.0).abs() < 0.005,
+        "tuning expression: {got} Hz, want {want}"
+    );
+    let plain = run(&Script {
+        events: &[(0, Send::On(69, 1.0))],
+        ..Script::new(INSTRUMENT, 24_000)
+    });
+    let pressed = run(&Script {
+        events: &[
+            (0, Send::On(69, 1.0)),
+            (0, Send::Expression(NoteExpressionType::Pressure, 69, 1.0)),
+        ],
+        ..Script::new(INSTRUMENT, 24_000)
+    });
+    assert!(
+        peak(&pressed.left[12_000..]) < 0.5 * peak(&plain.left[12_000..]),
+        "pressure expression did not damp"
     );
 }

@@ -660,3 +660,58 @@ fn all_sound_off_silences_at_once_and_all_notes_off_releases() {
     );
     assert!(e.is_silent());
 }
+
+#[test]
+fn note_expressions_change_one_note_only() {
+    // Two notes; the upper one is retuned up a whole tone and pressed, the lower is left alone.
+    let bank = simple_bank(&[(220.0, 1.0, 1.0)]);
+    let events = [
+        on(0, 57, 1.0),
+        on(0, 64, 1.0),
+        NoteEvent::Expression {
+            time: 4_800,
+            key: 64,
+            expression: modal_resonator::engine::NoteExpression::Tuning(2.0),
+        },
+    ];
+    let alone = |key: u8, expression: Option<modal_resonator::engine::NoteExpression>| {
+        let mut e = engine(&bank, RATE);
+        let mut ev = vec![on(0, key, 1.0)];
+        if let Some(x) = expression {
+            ev.push(NoteEvent::Expression {
+                time: 4_800,
+                key,
+                expression: x,
+            });
+        }
+        render(&mut e, &ev, 1.0, 256).0
+    };
+    let (both, _) = render(&mut engine(&bank, RATE), &events, 1.0, 256);
+    let retuned = alone(
+        64,
+        Some(modal_resonator::engine::NoteExpression::Tuning(2.0)),
+    );
+    let low = alone(57, None);
+    // Voices add: the pair equals the low note alone plus the retuned upper note alone.
+    for (i, ((b, l), r)) in both.iter().zip(&low).zip(&retuned).enumerate() {
+        assert!(
+            (b - (l + r)).abs() < 1e-5,
+            "sample {i}: the expression leaked to the other note"
+        );
+    }
+    let want = midi_key_to_hz(66.0) * 220.0 / midi_key_to_hz(57.0);
+    let got = pitch_hz(&retuned[9_600..], RATE as f64, 250.0, 450.0);
+    assert!(
+        (got / want - 1.0).abs() < 0.002,
+        "retuned note at {got} Hz, want {want}"
+    );
+    // Pressure damps the note it is applied to.
+    let pressed = alone(
+        57,
+        Some(modal_resonator::engine::NoteExpression::Pressure(1.0)),
+    );
+    assert!(
+        peak(&pressed[24_000..]) < 0.2 * peak(&low[24_000..]),
+        "pressure did not damp the note"
+    );
+}

@@ -188,9 +188,10 @@ impl Engine {
                 }
             }
             let key = if is_input { input_key } else { v.key };
+            let expression = v.tuning_semitones as f64 * std::f64::consts::LN_2 / 12.0;
             v.log_pitch = step_towards(
                 v.log_pitch,
-                target_log_pitch(controls, bank.root_key, key),
+                target_log_pitch(controls, bank.root_key, key) + expression,
                 pitch_k,
                 1e-6,
             );
@@ -222,6 +223,26 @@ impl Engine {
                 for i in 0..self.voices.len() {
                     if self.voices[i].state == VoiceState::Held {
                         self.release(i);
+                    }
+                }
+            }
+            NoteEvent::Expression {
+                key, expression, ..
+            } => {
+                for v in self
+                    .voices
+                    .iter_mut()
+                    .filter(|v| v.is_sounding() && v.key == key)
+                {
+                    match expression {
+                        NoteExpression::Tuning(semitones) if semitones.is_finite() => {
+                            v.tuning_semitones =
+                                semitones.clamp(-MAX_EXPRESSION_SEMITONES, MAX_EXPRESSION_SEMITONES)
+                        }
+                        NoteExpression::Pressure(p) if p.is_finite() => {
+                            v.pressure = p.clamp(0.0, 1.0)
+                        }
+                        _ => {}
                     }
                 }
             }
@@ -501,5 +522,6 @@ fn tuning_of(v: &Voice, damping_version: u64, release_decay_per_s: f64) -> Tunin
         } else {
             0.0
         },
+        log_damping: v.pressure as f64 * MAX_EXTRA_DAMPING.ln(),
     }
 }

@@ -37,6 +37,8 @@ pub struct Tuning {
     pub damping_version: u64,
     /// Lowest decay rate imposed by release damping, in 1/s (0 = none).
     pub release_decay_per_s: f64,
+    /// Natural log of this voice's own decay multiplier (per-note pressure).
+    pub log_damping: f64,
 }
 
 /// One voice.
@@ -60,6 +62,10 @@ pub struct Voice {
     pub energy: f32,
     /// Gain while fading after being stolen, 1 down to 0.
     pub fade_gain: f32,
+    /// Per-note tuning offset in semitones (note expression).
+    pub tuning_semitones: f32,
+    /// Per-note pressure 0 to 1, damping the object like a hand on it (note expression).
+    pub pressure: f32,
 }
 
 impl Voice {
@@ -75,6 +81,8 @@ impl Voice {
             applied: None,
             energy: 0.0,
             fade_gain: 1.0,
+            tuning_semitones: 0.0,
+            pressure: 0.0,
         }
     }
 
@@ -91,6 +99,8 @@ impl Voice {
         self.applied = None;
         self.energy = 0.0;
         self.fade_gain = 1.0;
+        self.tuning_semitones = 0.0;
+        self.pressure = 0.0;
     }
 
     /// Recomputes the coefficients of every live mode for `tuning`: angles scale with pitch,
@@ -104,13 +114,14 @@ impl Voice {
         tuning: Tuning,
     ) {
         let pitch = tuning.log_pitch.exp();
+        let damping = pitch * tuning.log_damping.exp();
         let theta_per_hz = TAU * pitch / sample_rate_hz;
         let inv_rate = 1.0 / sample_rate_hz;
         let release = tuning.release_decay_per_s;
         let fade = t60_to_decay(ABOVE_RANGE_T60_S);
         self.modes.set_poles_with(|m| {
             let theta = bank.freq_hz[m] * theta_per_hz;
-            let decay_per_s = (decay[m] * pitch).max(release);
+            let decay_per_s = (decay[m] * damping).max(release);
             if theta < THETA_MAX {
                 (theta, decay_per_s * inv_rate)
             } else {

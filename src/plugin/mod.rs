@@ -15,7 +15,7 @@ pub use bank_loader::{bank_from_state, build_engine, LoadedEngine, DEFAULT_FACTO
 pub use kind::{Effect, Instrument, Kind};
 
 use crate::dsp::onset::OnsetDetector;
-use crate::engine::{Engine, NoteEvent as EngineEvent};
+use crate::engine::{Engine, NoteEvent as EngineEvent, NoteExpression};
 use crate::params::{InputMode, ModalParams};
 
 /// The instrument plugin.
@@ -171,6 +171,26 @@ impl<K: Kind> ModalPlugin<K> {
                         key: key.number_or_middle_c(),
                     })
                 }
+                NoteEvent::PolyTuning {
+                    timing,
+                    key,
+                    tuning,
+                    ..
+                } => Some(EngineEvent::Expression {
+                    time: timing,
+                    key: key.number_or_middle_c(),
+                    expression: NoteExpression::Tuning(tuning),
+                }),
+                NoteEvent::PolyPressure {
+                    timing,
+                    key,
+                    pressure,
+                    ..
+                } => Some(EngineEvent::Expression {
+                    time: timing,
+                    key: key.number_or_middle_c(),
+                    expression: NoteExpression::Pressure(pressure),
+                }),
                 NoteEvent::MidiPitchBend { value, .. } => {
                     self.bend = (value * 2.0 - 1.0).clamp(-1.0, 1.0);
                     None

@@ -110,6 +110,8 @@ pub enum Send {
     Param(&'static str, f64),
     /// A raw MIDI message on port 0.
     Midi([u8; 3]),
+    /// A CLAP note expression on a key.
+    Expression(NoteExpressionType, u16, f64),
 }
 
 /// What one session with a plugin produced.
@@ -224,6 +226,12 @@ fn render_span(
                             value,
                         )),
                         Send::Midi(bytes) => evs.push(&MidiEvent::new(time, 0, bytes)),
+                        Send::Expression(kind, key, value) => evs.push(&NoteExpressionEvent::new(
+                            time,
+                            Pckn::new(0u16, 0u16, key, Match::All),
+                            kind,
+                            value,
+                        )),
                     }
                 }
                 let mut inp: [Vec<f32>; 2] = match script.input {

@@ -102,27 +102,7 @@ pub fn render(
 
 /// `event` with its time made relative to `offset`.
 pub fn shift(event: NoteEvent, offset: u32) -> NoteEvent {
-    match event {
-        NoteEvent::On {
-            time,
-            key,
-            velocity,
-        } => NoteEvent::On {
-            time: time - offset,
-            key,
-            velocity,
-        },
-        NoteEvent::Off { time, key } => NoteEvent::Off {
-            time: time - offset,
-            key,
-        },
-        NoteEvent::AllNotesOff { time } => NoteEvent::AllNotesOff {
-            time: time - offset,
-        },
-        NoteEvent::AllSoundOff { time } => NoteEvent::AllSoundOff {
-            time: time - offset,
-        },
-    }
+    event.at(event.time() - offset)
 }
 
 /// A note-on at absolute sample `time`.
