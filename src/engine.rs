@@ -72,6 +72,8 @@ pub enum NoteEvent {
     AllNotesOff { time: u32 },
     /// Silence every voice at once (MIDI CC 120).
     AllSoundOff { time: u32 },
+    /// Silence the voices on `key` at once (a hi-hat choke; CLAP choke events).
+    Choke { time: u32, key: u8 },
     /// Change the sounding note on `key` alone (CLAP note expressions, MPE).
     Expression {
         time: u32,
@@ -97,6 +99,7 @@ impl NoteEvent {
             | NoteEvent::Off { time, .. }
             | NoteEvent::AllNotesOff { time }
             | NoteEvent::AllSoundOff { time }
+            | NoteEvent::Choke { time, .. }
             | NoteEvent::Expression { time, .. } => time,
         }
     }
@@ -112,6 +115,7 @@ impl NoteEvent {
             NoteEvent::Off { key, .. } => NoteEvent::Off { time, key },
             NoteEvent::AllNotesOff { .. } => NoteEvent::AllNotesOff { time },
             NoteEvent::AllSoundOff { .. } => NoteEvent::AllSoundOff { time },
+            NoteEvent::Choke { key, .. } => NoteEvent::Choke { time, key },
             NoteEvent::Expression {
                 key, expression, ..
             } => NoteEvent::Expression {

@@ -715,3 +715,22 @@ fn note_expressions_change_one_note_only() {
         "pressure did not damp the note"
     );
 }
+
+#[test]
+fn a_choke_silences_its_key_at_once_and_no_other() {
+    let bank = dense_bank(30, 220.0);
+    let events = [
+        on(0, 57, 1.0),
+        on(0, 60, 1.0),
+        NoteEvent::Choke {
+            time: 2_000,
+            key: 57,
+        },
+    ];
+    let (l, _) = render(&mut engine(&bank, RATE), &events, 0.2, 256);
+    let (only_60, _) = render(&mut engine(&bank, RATE), &[on(0, 60, 1.0)], 0.2, 256);
+    // After the choke only key 60 sounds, exactly as if it had been played alone.
+    for (i, (a, b)) in l[2_000..].iter().zip(&only_60[2_000..]).enumerate() {
+        assert!((a - b).abs() < 1e-6, "sample {}: {a} vs {b}", i + 2_000);
+    }
+}

@@ -246,6 +246,15 @@ impl Engine {
                     }
                 }
             }
+            NoteEvent::Choke { key, .. } => {
+                for v in self
+                    .voices
+                    .iter_mut()
+                    .filter(|v| v.is_sounding() && v.key == key)
+                {
+                    v.free();
+                }
+            }
             NoteEvent::AllSoundOff { .. } => {
                 for v in self.voices.iter_mut().chain(self.input_voice.as_mut()) {
                     v.free();
@@ -329,6 +338,9 @@ impl Engine {
         if fresh {
             v.log_pitch = target;
         }
+        // A new note starts without the last one's per-note expression (its pitch glides back).
+        v.tuning_semitones = 0.0;
+        v.pressure = 0.0;
         v.state = VoiceState::Held;
         let tuning = tuning_of(&self.voices[i], self.damping_version, self.release_decay());
 

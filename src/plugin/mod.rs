@@ -26,10 +26,22 @@ pub type ModalResonatorFx = ModalPlugin<Effect>;
 /// Most note events (host events plus detected onsets) handled per block; more are dropped.
 const MAX_EVENTS: usize = 2048;
 
+/// Lowest sample rate the engine runs at, in Hz.
+const MIN_SAMPLE_RATE_HZ: f32 = 8_000.0;
+
 /// Work for the background thread.
 pub enum Task {
     /// Build an engine for the bank saved in the parameters, at this generation.
     LoadBank(u64),
+    /// Drop the engines the audio thread has handed back.
+    CollectGarbage,
+}
+
+/// Records the last problem loading a bank (or clears it).
+fn set_error(shared: &Shared, message: Option<String>) {
+    if let Ok(mut e) = shared.bank_error.write() {
+        *e = message;
+    }
 }
 
 /// Settings the background thread needs to build engines.
@@ -75,8 +87,10 @@ pub struct ModalPlugin<K: Kind> {
     mod_wheel: f32,
     /// Channel pressure, 0 to 1.
     pressure: f32,
-    /// Last key played: the pitch of onsets and of the input voice.
-    last_key: u8,
+    /// Last key struck, if any: the pitch of onsets (else the bank's root).
+    last_key: Option<u8>,
+    /// Dry/wet mix at the end of the last block; `None` after a reset (no ramp needed).
+    wet: Option<f32>,
     _kind: PhantomData<K>,
 }
 
@@ -101,7 +115,8 @@ impl<K: Kind> Default for ModalPlugin<K> {
             bend: 0.0,
             mod_wheel: 0.0,
             pressure: 0.0,
-            last_key: 60,
+            last_key: None,
+            wet: None,
             _kind: PhantomData,
         }
     }
@@ -114,33 +129,44 @@ impl<K: Kind> ModalPlugin<K> {
     }
 
     /// Swaps in an engine the background thread finished, and hands old engines back to it.
-    fn take_loaded_engine(&mut self) {
+    /// Returns whether any engine went to the trash (the background thread should drop it).
+    fn take_loaded_engine(&mut self) -> bool {
+        let mut trashed = false;
         if let Some(old) = self.pending_trash.take() {
-            if let Err(e) = self.trash_tx.try_send(old) {
-                self.pending_trash = Some(e.into_inner());
-            }
+            trashed |= self.discard(old);
         }
         if self.pending_trash.is_some() {
-            return;
+            return trashed;
         }
         let rate = f32::from_bits(self.shared.sample_rate_bits.load(Ordering::Acquire));
         while let Ok(loaded) = self.loaded_rx.try_recv() {
-            if loaded.generation != self.requested_generation
-                || loaded.engine.sample_rate_hz() != rate
-            {
-                // Superseded by a newer request, or built before the host changed the sample
-                // rate: discard off the audio thread.
-                if let Err(e) = self.trash_tx.try_send(loaded.engine) {
-                    self.pending_trash = Some(e.into_inner());
-                    return;
+            // Superseded by a newer request, or built before the host changed the sample rate:
+            // discard it. Otherwise swap it in and discard the old one.
+            let current = loaded.generation == self.requested_generation
+                && loaded.engine.sample_rate_hz() == rate;
+            let old = if current {
+                self.engine.replace(loaded.engine)
+            } else {
+                Some(loaded.engine)
+            };
+            if let Some(old) = old {
+                trashed |= self.discard(old);
+                if self.pending_trash.is_some() {
+                    break;
                 }
-                continue;
             }
-            if let Some(old) = self.engine.replace(loaded.engine) {
-                if let Err(e) = self.trash_tx.try_send(old) {
-                    self.pending_trash = Some(e.into_inner());
-                    return;
-                }
+        }
+        trashed
+    }
+
+    /// Hands `engine` to the background thread to be dropped there, or keeps it for later when
+    /// the trash is full. Never drops it here.
+    fn discard(&mut self, engine: Box<Engine>) -> bool {
+        match self.trash_tx.try_send(engine) {
+            Ok(()) => true,
+            Err(e) => {
+                self.pending_trash = Some(e.into_inner());
+                false
             }
         }
     }
@@ -158,19 +184,24 @@ impl<K: Kind> ModalPlugin<K> {
                     ..
                 } => {
                     let key = key.number_or_middle_c();
-                    self.last_key = key;
+                    if velocity > 0.0 {
+                        self.last_key = Some(key);
+                    }
                     Some(EngineEvent::On {
                         time: timing,
                         key,
                         velocity,
                     })
                 }
-                NoteEvent::NoteOff { timing, key, .. } | NoteEvent::Choke { timing, key, .. } => {
-                    Some(EngineEvent::Off {
-                        time: timing,
-                        key: key.number_or_middle_c(),
-                    })
-                }
+                // A wildcard key means every note.
+                NoteEvent::NoteOff { timing, key, .. } => Some(match key.number() {
+                    Some(key) => EngineEvent::Off { time: timing, key },
+                    None => EngineEvent::AllNotesOff { time: timing },
+                }),
+                NoteEvent::Choke { timing, key, .. } => Some(match key.number() {
+                    Some(key) => EngineEvent::Choke { time: timing, key },
+                    None => EngineEvent::AllSoundOff { time: timing },
+                }),
                 NoteEvent::PolyTuning {
                     timing,
                     key,
@@ -228,7 +259,10 @@ impl<K: Kind> ModalPlugin<K> {
     fn add_onsets(&mut self, n: usize) {
         let threshold = util::db_to_gain(self.params.trigger_threshold.value());
         let retrigger_s = self.params.retrigger.value() * 1e-3;
-        let key = self.last_key;
+        let root = self.engine.as_ref().map_or(60.0, |e| e.bank().root_key);
+        let key = self
+            .last_key
+            .unwrap_or(root.round().clamp(0.0, 127.0) as u8);
         let events = &mut self.events;
         self.onsets
             .process(&self.input[..n], threshold, retrigger_s, |onset| {
@@ -269,30 +303,32 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         let shared = self.shared.clone();
         let loaded_tx = self.loaded_tx.clone();
         let trash_rx = self.trash_rx.clone();
-        Box::new(move |task| match task {
-            Task::LoadBank(generation) => {
-                // Old engines are dropped here, off the audio thread.
-                while trash_rx.try_recv().is_ok() {}
-                let json = params
-                    .bank
-                    .json
-                    .read()
-                    .map(|j| j.clone())
-                    .unwrap_or_default();
-                match bank_from_state(&json) {
-                    Ok(bank) => {
-                        let rate = f32::from_bits(shared.sample_rate_bits.load(Ordering::Acquire));
-                        let max_block = shared.max_block.load(Ordering::Acquire) as usize;
-                        let engine = build_engine(&bank, rate, max_block);
-                        if let Ok(mut e) = shared.bank_error.write() {
-                            *e = None;
-                        }
-                        let _ = loaded_tx.try_send(LoadedEngine { generation, engine });
+        Box::new(move |task| {
+            // Engines the audio thread is done with are dropped here, off the audio thread.
+            while trash_rx.try_recv().is_ok() {}
+            match task {
+                Task::CollectGarbage => {}
+                Task::LoadBank(generation) => {
+                    // A newer bank is already on its way: building this one would be wasted.
+                    if params.bank.generation.load(Ordering::Acquire) != generation {
+                        return;
                     }
-                    Err(message) => {
-                        if let Ok(mut e) = shared.bank_error.write() {
-                            *e = Some(message);
+                    let json = params
+                        .bank
+                        .json
+                        .read()
+                        .map(|j| j.clone())
+                        .unwrap_or_default();
+                    match bank_from_state(&json) {
+                        Ok(bank) => {
+                            let rate =
+                                f32::from_bits(shared.sample_rate_bits.load(Ordering::Acquire));
+                            let max_block = shared.max_block.load(Ordering::Acquire) as usize;
+                            let engine = build_engine(&bank, rate, max_block);
+                            set_error(&shared, None);
+                            let _ = loaded_tx.try_send(LoadedEngine { generation, engine });
                         }
+                        Err(message) => set_error(&shared, Some(message)),
                     }
                 }
             }
@@ -306,6 +342,9 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         _context: &mut impl ActivateContext<Self>,
     ) -> bool {
         let rate = config.sample_rate;
+        if !(rate.is_finite() && rate >= MIN_SAMPLE_RATE_HZ) {
+            return false;
+        }
         let max_block = config.max_buffer_size.max(1) as usize;
         self.shared
             .sample_rate_bits
@@ -326,14 +365,19 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
             .map(|j| j.clone())
             .unwrap_or_default();
         let bank = match bank_from_state(&json) {
-            Ok(bank) => bank,
+            Ok(bank) => {
+                set_error(&self.shared, None);
+                bank
+            }
             Err(message) => {
-                if let Ok(mut e) = self.shared.bank_error.write() {
-                    *e = Some(message);
-                }
-                match bank_from_state("") {
-                    Ok(bank) => bank,
-                    Err(_) => return false,
+                set_error(&self.shared, Some(message));
+                // Keep the bank that was playing; the factory default only on a first start.
+                match self.engine.as_ref() {
+                    Some(engine) => engine.bank().source.clone(),
+                    None => match bank_from_state("") {
+                        Ok(bank) => bank,
+                        Err(_) => return false,
+                    },
                 }
             }
         };
@@ -350,9 +394,9 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
             engine.reset();
         }
         self.onsets.reset();
-        self.bend = 0.0;
-        self.mod_wheel = 0.0;
-        self.pressure = 0.0;
+        self.wet = None;
+        // Pitch bend, mod wheel and pressure are where the player left them: a host resets
+        // the plugin on every start of processing, and the wheel has not moved.
     }
 
     fn process(
@@ -366,7 +410,9 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
             self.requested_generation = generation;
             context.execute_background(Task::LoadBank(generation));
         }
-        self.take_loaded_engine();
+        if self.take_loaded_engine() {
+            context.execute_background(Task::CollectGarbage);
+        }
         self.read_events(context);
 
         let n = buffer.samples();
@@ -408,12 +454,17 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         engine.process(&self.events, drive, &mut left[0][..n], &mut rest[0][..n]);
 
         if K::IS_EFFECT {
-            let wet = self.params.dry_wet.value();
+            // Ramp from the last block's mix to this one's, so automation does not zipper.
+            let to = self.params.dry_wet.value();
+            let from = self.wet.unwrap_or(to);
+            let step = (to - from) / n as f32;
             for (channel, dry) in channels.iter_mut().zip(&self.dry) {
-                for (out, d) in channel[..n].iter_mut().zip(&dry[..n]) {
+                for (i, (out, d)) in channel[..n].iter_mut().zip(&dry[..n]).enumerate() {
+                    let wet = from + step * (i + 1) as f32;
                     *out = wet * *out + (1.0 - wet) * d;
                 }
             }
+            self.wet = Some(to);
         }
         if engine.is_silent() {
             ProcessStatus::Normal
