@@ -11,35 +11,16 @@ use std::hint::black_box;
 use std::sync::Arc;
 use std::time::Instant;
 
+use common::bench_bank;
 use common::clap::{run, with_bank, Script, Send, INSTRUMENT};
 use modal_resonator::engine::{Engine, NoteEvent, PreparedBank};
-use modal_resonator::model::{Bank, Mode, Position};
+use modal_resonator::model::Bank;
 use modal_resonator::params::ModalParams;
 
 const RATE_HZ: f32 = 48_000.0;
 const BLOCK: usize = 64;
 /// Keys 24 to 39: 16 voices, every mode below 0.45 fs.
 const KEYS: std::ops::Range<u8> = 24..40;
-
-/// 256 modes ringing for about a minute, so every mode stays live for the whole run.
-fn bank() -> Bank {
-    let mut bank = Bank::new(
-        "bench",
-        vec![Position {
-            name: "a".into(),
-            coords: vec![0.0],
-        }],
-    );
-    bank.modes = (0..256)
-        .map(|i| Mode {
-            freq_hz: 60.0 * (1.0 + i as f64 * 0.37),
-            decay_per_s: 0.2,
-            gains: vec![1.0 / (1.0 + i as f64)],
-        })
-        .collect();
-    bank.root_hz = Some(60.0);
-    bank
-}
 
 /// Real-time factor of the engine alone, with the plugin's default controls.
 fn engine_realtime_factor(bank: &Bank, seconds: f64) -> f64 {
@@ -87,7 +68,7 @@ fn main() {
     // `cargo test --benches` runs this without --bench: keep that quick.
     let quick = !std::env::args().any(|a| a == "--bench");
     let seconds = if quick { 0.2 } else { 10.0 };
-    let bank = bank();
+    let bank = bench_bank();
     let repeats = if quick { 1 } else { 3 };
     let best = |f: &dyn Fn() -> f64| (0..repeats).map(|_| f()).fold(0.0, f64::max);
     let plugin = best(&|| plugin_realtime_factor(&bank, seconds));

@@ -5,6 +5,9 @@
 //! ratios are side by side), then the real-time factor of 16 voices x 256 modes at 48 kHz in
 //! 64-sample blocks through the whole engine.
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 use std::hint::black_box;
 use std::sync::Arc;
 use std::time::Instant;
@@ -12,7 +15,6 @@ use std::time::Instant;
 use modal_resonator::dsp::coeffs::ModeCoeffs;
 use modal_resonator::dsp::{Kernel, ResonatorBank, COLUMNS};
 use modal_resonator::engine::{Engine, NoteEvent, PreparedBank};
-use modal_resonator::model::{Bank, Mode, Position};
 
 const RATE_HZ: f64 = 48_000.0;
 const BLOCK: usize = 64;
@@ -60,19 +62,7 @@ fn mode_samples_per_s(kernel: Kernel, num_modes: usize, work: usize, driven: boo
 /// Real-time factor of the engine; with `sweep`, the pitch bend moves every block so every voice
 /// recomputes its coefficients on every control tick.
 fn engine_realtime_factor(kernel: Kernel, sweep: bool, seconds: f64) -> (f64, usize) {
-    let positions = vec![Position {
-        name: "a".into(),
-        coords: vec![0.0],
-    }];
-    let mut bank = Bank::new("bench", positions);
-    bank.modes = (0..256)
-        .map(|i| Mode {
-            freq_hz: 60.0 * (1.0 + i as f64 * 0.37),
-            decay_per_s: 0.2,
-            gains: vec![1.0 / (1.0 + i as f64)],
-        })
-        .collect();
-    bank.root_hz = Some(60.0);
+    let bank = common::bench_bank();
     let prepared = Arc::new(PreparedBank::new(&bank));
     let mut best = f64::INFINITY;
     let mut live = 0;

@@ -146,15 +146,6 @@ impl ResonatorBank {
         );
     }
 
-    /// Sets the coefficients of every live mode to `coeffs_of(mode)`.
-    pub fn set_coeffs_with(&mut self, mut coeffs_of: impl FnMut(usize) -> ModeCoeffs) {
-        for slot in self.live_slots() {
-            let c = coeffs_of(self.mode_of_slot[slot] as usize);
-            self.q_re[slot] = c.q_re;
-            self.q_im[slot] = c.q_im;
-        }
-    }
-
     /// Sets the input gain of every live mode to `gain_of(mode)`.
     pub fn set_gains_with(&mut self, mut gain_of: impl FnMut(usize) -> f32) {
         for slot in self.live_slots() {

@@ -178,7 +178,7 @@ impl Engine {
                 // add up to far more.)
                 let live = v.modes.num_live();
                 let share = (v.modes.num_started().max(1) as f32).sqrt();
-                v.energy = v.modes.retire_below(threshold / share);
+                v.modes.retire_below(threshold / share);
                 if is_input && v.modes.num_live() < live {
                     self.input_dormant = true;
                 }

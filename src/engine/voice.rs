@@ -58,8 +58,6 @@ pub struct Voice {
     pub log_pitch: f64,
     /// The tuning the coefficients hold, or `None` when they must be recomputed.
     pub applied: Option<Tuning>,
-    /// Summed squared amplitude of the modes at the last control tick.
-    pub energy: f32,
     /// Gain while fading after being stolen, 1 down to 0.
     pub fade_gain: f32,
     /// Per-note tuning offset in semitones (note expression).
@@ -79,7 +77,6 @@ impl Voice {
             exciter: Exciter::new(seed),
             log_pitch: 0.0,
             applied: None,
-            energy: 0.0,
             fade_gain: 1.0,
             tuning_semitones: 0.0,
             pressure: 0.0,
@@ -97,7 +94,6 @@ impl Voice {
         self.modes.clear();
         self.exciter.reset();
         self.applied = None;
-        self.energy = 0.0;
         self.fade_gain = 1.0;
         self.tuning_semitones = 0.0;
         self.pressure = 0.0;

@@ -161,3 +161,24 @@ pub fn magnitude_at(x: &[f32], rate: f64, freq_hz: f64) -> f64 {
     }
     (re * re + im * im).sqrt()
 }
+
+/// The benchmarks' bank: 256 modes ringing for about a minute, so every mode stays live for
+/// the whole run.
+pub fn bench_bank() -> modal_resonator::model::Bank {
+    let mut bank = modal_resonator::model::Bank::new(
+        "bench",
+        vec![modal_resonator::model::Position {
+            name: "a".into(),
+            coords: vec![0.0],
+        }],
+    );
+    bank.modes = (0..256)
+        .map(|i| modal_resonator::model::Mode {
+            freq_hz: 60.0 * (1.0 + i as f64 * 0.37),
+            decay_per_s: 0.2,
+            gains: vec![1.0 / (1.0 + i as f64)],
+        })
+        .collect();
+    bank.root_hz = Some(60.0);
+    bank
+}
