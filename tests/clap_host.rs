@@ -180,6 +180,20 @@ fn process_never_allocates_through_storms_sweeps_and_bank_swaps() {
             };
             events.push((t0 + (k * 3) % BLOCK, Send::Param(id, value)));
         }
+        // Notes with ids on MPE channels, their polyphonic modulation, member-channel bends and
+        // pressure, and the mod wheel.
+        for i in 0..8 {
+            let t = t0 + (i * 31) % BLOCK;
+            let id = (b * 8 + i) as u32;
+            let channel = (i % 4) as u16;
+            events.push((t, Send::NoteOn((30 + i * 9) as u16, channel, id, 0.8)));
+            let param = ["fine", "size", "posx", "posy", "hard"][i % 5];
+            events.push((t, Send::Mod(param, id, (i as f64 - 4.0) / 8.0)));
+            let byte = ((b * 5 + i * 17) % 128) as u8;
+            events.push((t + 1, Send::Midi([0xE0 | channel as u8, byte, byte])));
+            events.push((t + 2, Send::Midi([0xD0 | channel as u8, byte, 0])));
+            events.push((t + 3, Send::Midi([0xB0, 1, byte])));
+        }
     }
     events.sort_by_key(|(t, _)| *t);
     let first = run(&Script {
@@ -196,6 +210,9 @@ fn process_never_allocates_through_storms_sweeps_and_bank_swaps() {
         events: &events,
         input: Some(&input),
         swap: Some((blocks * BLOCK / 2, &bytes)),
+        // Blocks of varying size. (Blocks beyond the announced maximum are a host error that
+        // nice-plug answers by growing its own buffers, so they are left out here.)
+        blocks: &[BLOCK, 100, 1, 37],
         ..Script::new(INSTRUMENT, blocks * BLOCK)
     });
     assert_eq!(s.left.len(), blocks * BLOCK);

@@ -215,7 +215,9 @@ fn render_span(
             let mut p = processor.start_processing().unwrap();
             let mut in_ports = AudioPorts::with_capacity(2, 1);
             let mut out_ports = AudioPorts::with_capacity(2, 1);
-            let mut out_events = EventBuffer::new();
+            // Room for every note end of a block, so the plugin's pushes never allocate here
+            // (the allocation-checking build would count them as its own).
+            let mut out_events = EventBuffer::with_capacity(4_096);
             let mut start = span.start;
             let mut block = 0;
             while start < span.end {
