@@ -9,7 +9,9 @@ pub mod coeffs_batch;
 pub mod denormal;
 pub mod exciter;
 pub mod kernels;
+pub mod masking;
 pub mod onset;
+pub mod pruning;
 pub mod resonator_bank;
 pub mod rng;
 

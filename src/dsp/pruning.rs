@@ -1,0 +1,371 @@
+//! The masking pass of perceptual mode pruning (seed 001 section 4, steps 5 to 7 of its
+//! pseudo-code), and the selection of the modes a computation budget keeps (seed 000 sections 5.5
+//! and 6.4).
+//!
+//! The pass takes candidate modes as plain slices (level in dB SPL, critical-band rate in Bark,
+//! threshold in quiet in dB SPL), sorts them by level, drops those below the threshold of hearing,
+//! and walks them loudest first against the upper envelope of the masking curves of the modes
+//! kept so far: a mode under the envelope is masked; a mode within the masking offset above it
+//! is kept but masks nothing. Sorting first keeps the cost near `O(N log N + N M)` with `M` the
+//! number of maskers (about `2 sqrt(N)`, seed 001), instead of `O(N^2)` pairs. The envelope at a
+//! mode is evaluated against all maskers at once, eight lanes at a time.
+//!
+//! Storage is sized by [`MaskingPass::with_capacity`]; [`MaskingPass::run`] never allocates.
+
+use std::cmp::Reverse;
+
+use super::masking::{upper_slope_db_per_bark, LOWER_SLOPE_DB_PER_BARK};
+
+/// What the pass decided for one candidate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Verdict {
+    /// Heard: compute it. With `masker`, it may mask quieter modes.
+    Audible {
+        /// Whether its masking curve joins the envelope.
+        masker: bool,
+    },
+    /// Below the threshold of hearing.
+    Inaudible,
+    /// Under the masking curve of candidate `by`.
+    Masked {
+        /// Index of a candidate whose curve lies above this one.
+        by: u32,
+    },
+}
+
+impl Verdict {
+    /// Whether the mode is to be computed.
+    pub fn is_audible(self) -> bool {
+        matches!(self, Verdict::Audible { .. })
+    }
+}
+
+/// Levels are sorted as whole multiples of this, in dB: finer than any decision the curves make.
+const SORT_STEP_DB: f32 = 1.0 / 256.0;
+
+/// Highest level the sort keys distinguish, in dB SPL; anything louder sorts first.
+const SORT_CEILING_DB: f32 = 1000.0;
+
+/// Lanes of the envelope evaluation.
+const LANES: usize = 8;
+
+/// Scratch storage for the masking pass.
+#[derive(Debug, Clone, Default)]
+pub struct MaskingPass {
+    /// Sort keys: quantised level (loudest first) in the high half, candidate index in the low.
+    order: Vec<u64>,
+    /// Bark of each masker, padded to a whole number of lanes.
+    masker_bark: Vec<f32>,
+    /// `L - a_v` of each masker: its curve's peak.
+    masker_peak: Vec<f32>,
+    /// Upper slope of each masker's curve, dB per Bark.
+    masker_upper_slope: Vec<f32>,
+    /// Candidate index of each masker.
+    masker_index: Vec<u32>,
+    /// Number of maskers found by the last run.
+    num_maskers: usize,
+}
+
+impl MaskingPass {
+    /// Storage for passes over up to `capacity` candidates. Allocates.
+    pub fn with_capacity(capacity: usize) -> Self {
+        let padded = capacity.div_ceil(LANES) * LANES;
+        Self {
+            order: Vec::with_capacity(capacity),
+            masker_bark: vec![0.0; padded],
+            masker_peak: vec![f32::NEG_INFINITY; padded],
+            masker_upper_slope: vec![0.0; padded],
+            masker_index: vec![0; capacity],
+            num_maskers: 0,
+        }
+    }
+
+    /// Most candidates one run takes.
+    pub fn capacity(&self) -> usize {
+        self.masker_index.len()
+    }
+
+    /// Maskers found by the last run.
+    pub fn num_maskers(&self) -> usize {
+        self.num_maskers
+    }
+
+    /// Classifies every candidate `i` with level `level_db[i]` at `bark[i]` and threshold in quiet
+    /// `threshold_db[i]` into `verdicts[i]`, with masking offset `offset_db` (`a_v`, seed 001).
+    /// The loudest candidate is always audible. Candidates beyond the capacity are an error.
+    pub fn run(
+        &mut self,
+        level_db: &[f32],
+        bark: &[f32],
+        threshold_db: &[f32],
+        offset_db: f32,
+        verdicts: &mut [Verdict],
+    ) {
+        let n = level_db.len();
+        assert!(
+            bark.len() == n && threshold_db.len() == n && verdicts.len() == n,
+            "candidate slices differ in length"
+        );
+        assert!(n <= self.capacity(), "{n} candidates, capacity {}", self.capacity());
+        // Step 5: sort by level, loudest first. The order fits `Vec::with_capacity`, so neither
+        // the pushes nor the in-place sort allocate.
+        self.order.clear();
+        for (i, &l) in level_db.iter().enumerate() {
+            // NaN levels sort last and are below any threshold.
+            let key = if l.is_nan() {
+                u32::MAX
+            } else {
+                ((SORT_CEILING_DB - l) / SORT_STEP_DB).clamp(0.0, u32::MAX as f32 - 1.0) as u32
+            };
+            self.order.push(((key as u64) << 32) | i as u64);
+        }
+        self.order.sort_unstable();
+
+        self.num_maskers = 0;
+        for rank in 0..n {
+            let i = (self.order[rank] & 0xffff_ffff) as usize;
+            let (l, b) = (level_db[i], bark[i]);
+            // Step 6: below the threshold of hearing (the loudest mode is always kept, so
+            // pruning never silences a sounding object).
+            if rank > 0 && !(l > threshold_db[i]) {
+                verdicts[i] = Verdict::Inaudible;
+                continue;
+            }
+            // Step 7, against the envelope of every masker so far at once.
+            let envelope = self.envelope_at(b);
+            verdicts[i] = if l < envelope {
+                Verdict::Masked {
+                    by: self.masker_above(b, l),
+                }
+            } else if rank > 0 && l < envelope.max(threshold_db[i]) + offset_db {
+                // Close to a masker's curve, or to the threshold in quiet (the seed's curve
+                // includes it, eq. 4): heard, but too faint to mask.
+                Verdict::Audible { masker: false }
+            } else {
+                self.push_masker(i, b, l, offset_db);
+                Verdict::Audible { masker: true }
+            };
+        }
+        // Leave the padding inert for the next run.
+        let used = self.num_maskers.div_ceil(LANES) * LANES;
+        self.masker_peak[..used].fill(f32::NEG_INFINITY);
+    }
+
+    /// Upper envelope of the maskers' curves at `bark` (seed 001 eq. 4 without the threshold in
+    /// quiet, which the caller has already applied).
+    #[inline]
+    fn envelope_at(&self, bark: f32) -> f32 {
+        let used = self.num_maskers.div_ceil(LANES) * LANES;
+        let mut lanes = [f32::NEG_INFINITY; LANES];
+        for ((mb, peak), su) in self.masker_bark[..used]
+            .chunks_exact(LANES)
+            .zip(self.masker_peak[..used].chunks_exact(LANES))
+            .zip(self.masker_upper_slope[..used].chunks_exact(LANES))
+        {
+            for l in 0..LANES {
+                let below = LOWER_SLOPE_DB_PER_BARK * (mb[l] - bark);
+                let above = su[l] * (bark - mb[l]);
+                let distance = if below > above { below } else { above };
+                let curve = peak[l] - distance;
+                lanes[l] = if curve > lanes[l] { curve } else { lanes[l] };
+            }
+        }
+        lanes.into_iter().fold(f32::NEG_INFINITY, f32::max)
+    }
+
+    /// Candidate index of the first masker whose curve at `bark` lies above `level_db`.
+    fn masker_above(&self, bark: f32, level_db: f32) -> u32 {
+        (0..self.num_maskers)
+            .find(|&j| {
+                let below = LOWER_SLOPE_DB_PER_BARK * (self.masker_bark[j] - bark);
+                let above = self.masker_upper_slope[j] * (bark - self.masker_bark[j]);
+                self.masker_peak[j] - below.max(above) > level_db
+            })
+            .map_or(0, |j| self.masker_index[j])
+    }
+
+    fn push_masker(&mut self, index: usize, bark: f32, level_db: f32, offset_db: f32) {
+        let j = self.num_maskers;
+        self.masker_bark[j] = bark;
+        self.masker_peak[j] = level_db - offset_db;
+        self.masker_upper_slope[j] = upper_slope_db_per_bark(level_db);
+        self.masker_index[j] = index as u32;
+        self.num_maskers += 1;
+    }
+}
+
+/// Reorders `ranked` so that its first `keep` entries are those with the most energy (the first
+/// value of each pair, seed 000 eq. 5.15), in no particular order. Does not allocate.
+pub fn keep_most_energetic(ranked: &mut [(f32, u32)], keep: usize) {
+    if keep == 0 || keep >= ranked.len() {
+        return;
+    }
+    ranked.select_nth_unstable_by_key(keep - 1, |&(e, i)| (Reverse(OrderedEnergy(e)), i));
+}
+
+/// Energies ordered totally (NaN as the least).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct OrderedEnergy(f32);
+
+impl Eq for OrderedEnergy {}
+
+impl PartialOrd for OrderedEnergy {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for OrderedEnergy {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        let key = |e: f32| if e.is_nan() { f32::NEG_INFINITY } else { e };
+        key(self.0).total_cmp(&key(other.0))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::masking::{masking_curve_db, masking_threshold_db};
+    use super::*;
+
+    /// The seed's pseudo-code, literally: every pair, `O(N^2)`.
+    fn reference(level: &[f32], bark: &[f32], threshold: &[f32], av: f32) -> Vec<bool> {
+        let n = level.len();
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|&a, &b| level[b].total_cmp(&level[a]));
+        let mut on = vec![false; n];
+        let mut masker = vec![false; n];
+        for (rank, &i) in order.iter().enumerate() {
+            on[i] = rank == 0 || level[i] > threshold[i];
+            masker[i] = on[i];
+        }
+        for a in 0..n {
+            let i = order[a];
+            if !masker[i] {
+                continue;
+            }
+            for &k in &order[a + 1..] {
+                if !on[k] {
+                    continue;
+                }
+                let th = masking_threshold_db(bark[i], level[i], av, bark[k], threshold[k]);
+                if level[k] < th {
+                    on[k] = false;
+                    masker[k] = false;
+                } else if level[k] < th + av {
+                    masker[k] = false;
+                }
+            }
+        }
+        on
+    }
+
+    fn random_scene(n: usize, seed: u32) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+        let mut s = seed;
+        let mut rnd = move || {
+            s ^= s << 13;
+            s ^= s >> 17;
+            s ^= s << 5;
+            s as f32 / u32::MAX as f32
+        };
+        let level: Vec<f32> = (0..n).map(|_| 90.0 * rnd()).collect();
+        let bark: Vec<f32> = (0..n).map(|_| 24.0 * rnd()).collect();
+        let threshold: Vec<f32> = (0..n).map(|_| 10.0 * rnd()).collect();
+        (level, bark, threshold)
+    }
+
+    #[test]
+    fn the_pass_agrees_with_the_seeds_pairwise_algorithm() {
+        for (n, seed, av) in [(50, 1, 5.0), (700, 2, 2.5), (2000, 3, 10.0), (300, 4, 0.0)] {
+            let (level, bark, threshold) = random_scene(n, seed);
+            let mut pass = MaskingPass::with_capacity(n);
+            let mut verdicts = vec![Verdict::Inaudible; n];
+            pass.run(&level, &bark, &threshold, av, &mut verdicts);
+            let want = reference(&level, &bark, &threshold, av);
+            for i in 0..n {
+                assert_eq!(
+                    verdicts[i].is_audible(),
+                    want[i],
+                    "n {n}, a_v {av}: candidate {i} ({} dB at {} Bark): {:?}",
+                    level[i],
+                    bark[i],
+                    verdicts[i]
+                );
+            }
+            // Roughly 2 sqrt(N) maskers (seed 001, footnote 1): far fewer than N.
+            assert!(pass.num_maskers() < n / 2, "{} maskers", pass.num_maskers());
+        }
+    }
+
+    #[test]
+    fn a_loud_mode_masks_a_quiet_neighbour_and_not_a_distant_one() {
+        // 70 dB at 10 Bark; 40 dB at 10.5 Bark (curve 65 - 22 * 0.5 = 54 dB there: masked);
+        // 40 dB at 16 Bark (curve 65 - 8 * 6 = 17 dB: heard).
+        let level = [70.0, 40.0, 40.0];
+        let bark = [10.0, 10.5, 16.0];
+        let threshold = [3.0; 3];
+        let mut pass = MaskingPass::with_capacity(3);
+        let mut v = [Verdict::Inaudible; 3];
+        pass.run(&level, &bark, &threshold, 5.0, &mut v);
+        assert_eq!(v[0], Verdict::Audible { masker: true });
+        assert_eq!(v[1], Verdict::Masked { by: 0 });
+        assert!(v[2].is_audible(), "{:?}", v[2]);
+        assert!(masking_curve_db(10.0, 70.0, 5.0, 10.5) > 40.0);
+    }
+
+    #[test]
+    fn a_quiet_isolated_mode_above_the_threshold_is_kept_and_one_below_is_not() {
+        let level = [20.0, 8.0, 2.0];
+        let bark = [5.0, 20.0, 22.0];
+        let threshold = [5.0, 6.0, 9.0];
+        let mut pass = MaskingPass::with_capacity(3);
+        let mut v = [Verdict::Inaudible; 3];
+        pass.run(&level, &bark, &threshold, 5.0, &mut v);
+        assert!(v[0].is_audible() && v[1].is_audible());
+        assert_eq!(v[2], Verdict::Inaudible);
+    }
+
+    #[test]
+    fn the_loudest_mode_is_never_removed() {
+        // Even below the threshold of hearing.
+        let mut pass = MaskingPass::with_capacity(4);
+        let mut v = [Verdict::Inaudible; 3];
+        pass.run(&[-10.0, -20.0, -30.0], &[1.0, 2.0, 3.0], &[20.0; 3], 5.0, &mut v);
+        assert_eq!(v[0], Verdict::Audible { masker: true });
+        assert_eq!(&v[1..], &[Verdict::Inaudible; 2]);
+        // And among random scenes at every offset.
+        for seed in 1..20 {
+            let (level, bark, threshold) = random_scene(200, seed);
+            let loudest = (0..200)
+                .max_by(|&a, &b| level[a].total_cmp(&level[b]))
+                .unwrap();
+            let mut verdicts = vec![Verdict::Inaudible; 200];
+            let mut pass = MaskingPass::with_capacity(200);
+            pass.run(&level, &bark, &threshold, 0.0, &mut verdicts);
+            assert!(verdicts[loudest].is_audible(), "seed {seed}");
+        }
+    }
+
+    #[test]
+    fn a_larger_offset_prunes_less() {
+        let (level, bark, threshold) = random_scene(1000, 9);
+        let mut pass = MaskingPass::with_capacity(1000);
+        let mut verdicts = vec![Verdict::Inaudible; 1000];
+        let mut kept = Vec::new();
+        for av in [0.0, 2.5, 5.0, 10.0, 20.0] {
+            pass.run(&level, &bark, &threshold, av, &mut verdicts);
+            kept.push(verdicts.iter().filter(|v| v.is_audible()).count());
+        }
+        assert!(kept.windows(2).all(|w| w[0] <= w[1]), "{kept:?}");
+    }
+
+    #[test]
+    fn the_budget_keeps_the_most_energetic() {
+        let mut ranked: Vec<(f32, u32)> = (0..100)
+            .map(|i| (((i * 37) % 100) as f32, i as u32))
+            .collect();
+        keep_most_energetic(&mut ranked, 10);
+        let mut top: Vec<f32> = ranked[..10].iter().map(|r| r.0).collect();
+        top.sort_by(f32::total_cmp);
+        assert_eq!(top, (90..100).map(|e| e as f32).collect::<Vec<_>>());
+    }
+}
