@@ -207,7 +207,11 @@ mod tests {
         // 13 atan(0.76) + 3.5 atan((1/7.5)^2), worked by hand.
         let at_1k = 13.0 * 0.76f64.atan() + 3.5 * (1.0f64 / 56.25).atan();
         assert!((hz_to_bark(1000.0) - at_1k).abs() < 1e-12);
-        assert!((hz_to_bark(1000.0) - 8.5105).abs() < 1e-3, "{}", hz_to_bark(1000.0));
+        assert!(
+            (hz_to_bark(1000.0) - 8.5105).abs() < 1e-3,
+            "{}",
+            hz_to_bark(1000.0)
+        );
         assert_eq!(hz_to_bark(0.0), 0.0);
         // The band edges of Zwicker's critical-band table, within 0.2 Bark.
         for (f, z) in [(100.0, 1.0), (510.0, 5.0), (2000.0, 13.0), (9500.0, 22.0)] {
@@ -272,7 +276,10 @@ mod tests {
             unmask_delay_samples(10.0, 60.0, 0.1, 5.0, 9.0, 25.0, 0.5),
             f32::INFINITY
         );
-        assert_eq!(unmask_delay_samples(10.0, 60.0, 1.0, 5.0, 9.0, 45.0, 0.5), 0.0);
+        assert_eq!(
+            unmask_delay_samples(10.0, 60.0, 1.0, 5.0, 9.0, 45.0, 0.5),
+            0.0
+        );
     }
 
     #[test]

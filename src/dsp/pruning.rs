@@ -106,7 +106,11 @@ impl MaskingPass {
             bark.len() == n && threshold_db.len() == n && verdicts.len() == n,
             "candidate slices differ in length"
         );
-        assert!(n <= self.capacity(), "{n} candidates, capacity {}", self.capacity());
+        assert!(
+            n <= self.capacity(),
+            "{n} candidates, capacity {}",
+            self.capacity()
+        );
         // Step 5: sort by level, loudest first. The order fits `Vec::with_capacity`, so neither
         // the pushes nor the in-place sort allocate.
         self.order.clear();
@@ -329,7 +333,13 @@ mod tests {
         // Even below the threshold of hearing.
         let mut pass = MaskingPass::with_capacity(4);
         let mut v = [Verdict::Inaudible; 3];
-        pass.run(&[-10.0, -20.0, -30.0], &[1.0, 2.0, 3.0], &[20.0; 3], 5.0, &mut v);
+        pass.run(
+            &[-10.0, -20.0, -30.0],
+            &[1.0, 2.0, 3.0],
+            &[20.0; 3],
+            5.0,
+            &mut v,
+        );
         assert_eq!(v[0], Verdict::Audible { masker: true });
         assert_eq!(&v[1..], &[Verdict::Inaudible; 2]);
         // And among random scenes at every offset.

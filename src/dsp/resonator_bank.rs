@@ -8,11 +8,21 @@
 //! `m % COLUMNS` when that column is among the emptiest, else to the next emptiest one: modes
 //! sorted by frequency are dealt round the columns, and a bank where every other mode is silent
 //! (a string struck at its middle) still fills every lane.
+//!
+//! A mode can also be *dormant* (switched off by perceptual pruning or a budget): it leaves the
+//! rows the kernels run over, and its state is carried analytically instead ([`dormant`]), so it
+//! can return in phase. Switching off and on fades the mode's output over a given number of
+//! samples through its pole, at no cost per sample.
+
+mod dormant;
+
+pub use dormant::{ActiveMode, DormantMode, FADE_DEPTH_NEPERS};
 
 use super::coeffs::ModeCoeffs;
 use super::coeffs_batch::coeffs_batch;
 pub use super::kernels::COLUMNS;
 use super::kernels::{self, Kernel, Rows, ROW_BLOCK};
+use dormant::Dormant;
 
 /// Marks a mode that has no slot, or a slot that holds no mode.
 const NONE: u32 = u32::MAX;
@@ -40,10 +50,28 @@ pub struct ResonatorBank {
     rows_active: usize,
     /// Modes started since the bank was last cleared (counting restarts).
     num_started: usize,
-    /// Scratch: pole angle of each slot, for batch coefficient updates.
+    /// Pole angle of each slot's mode in radians per sample, without any fade; NaN when the mode
+    /// was given coefficients directly (then read back from them when needed).
     theta: Vec<f64>,
-    /// Scratch: pole radius exponent of each slot, for batch coefficient updates.
+    /// Pole radius exponent (decay per sample) of each slot's mode, without any fade.
     delta: Vec<f64>,
+    /// Extra decay per sample of a slot while it fades: positive fading out, negative fading in,
+    /// zero when steady.
+    fade_delta: Vec<f64>,
+    /// Bank clock at which a slot's fade ends.
+    fade_end: Vec<u64>,
+    /// Number of slots fading.
+    num_fading: usize,
+    /// Samples processed since the bank was last cleared: the time base of dormant modes.
+    clock: u64,
+    /// Records of modes whose state is carried analytically; the first `num_dormant` are in use.
+    dormant: Vec<Dormant>,
+    /// Number of records in use (including those of modes still fading out).
+    num_dormant: usize,
+    /// Index into `dormant` of each mode's record, or `NONE`.
+    dormant_of_mode: Vec<u32>,
+    /// Number of modes fading out: they have both a slot and a record.
+    num_fading_out: usize,
 }
 
 impl ResonatorBank {
@@ -64,6 +92,14 @@ impl ResonatorBank {
             num_started: 0,
             theta: vec![0.0; slots],
             delta: vec![0.0; slots],
+            fade_delta: vec![0.0; slots],
+            fade_end: vec![0; slots],
+            num_fading: 0,
+            clock: 0,
+            dormant: vec![Dormant::EMPTY; num_modes],
+            num_dormant: 0,
+            dormant_of_mode: vec![NONE; num_modes],
+            num_fading_out: 0,
         }
     }
 
@@ -72,8 +108,13 @@ impl ResonatorBank {
         self.slot_of_mode.len()
     }
 
-    /// Number of modes currently sounding.
+    /// Number of modes currently sounding, computed or dormant.
     pub fn num_live(&self) -> usize {
+        self.num_active() + self.num_dormant - self.num_fading_out
+    }
+
+    /// Number of modes the kernels compute (fading ones included).
+    pub fn num_active(&self) -> usize {
         self.live.iter().map(|&n| n as usize).sum()
     }
 
@@ -88,12 +129,12 @@ impl ResonatorBank {
         self.num_started
     }
 
-    /// Whether mode `mode` is sounding.
+    /// Whether mode `mode` is sounding, computed or dormant.
     pub fn is_live(&self, mode: usize) -> bool {
-        self.slot_of_mode[mode] != NONE
+        self.slot_of_mode[mode] != NONE || self.dormant_of_mode[mode] != NONE
     }
 
-    /// The phasor state `(re, im)` of a mode, or `None` when it is not sounding.
+    /// The phasor state `(re, im)` of a mode, or `None` when it is not computed.
     pub fn state(&self, mode: usize) -> Option<(f32, f32)> {
         let slot = self.slot_of_mode[mode];
         (slot != NONE).then(|| (self.re[slot as usize], self.im[slot as usize]))
@@ -105,28 +146,43 @@ impl ResonatorBank {
         if self.is_live(mode) {
             return false;
         }
-        let fewest = self.live.iter().copied().min().unwrap_or(0);
-        let column = (0..COLUMNS)
-            .map(|i| (mode + i) % COLUMNS)
-            .find(|&c| self.live[c] == fewest)
-            .unwrap_or(mode % COLUMNS);
-        let slot = self.live[column] as usize * COLUMNS + column;
-        self.live[column] += 1;
-        self.re[slot] = 0.0;
-        self.im[slot] = 0.0;
+        let slot = self.push_slot(mode, self.column_for(mode));
         self.q_re[slot] = coeffs.q_re;
         self.q_im[slot] = coeffs.q_im;
         self.gain[slot] = gain;
+        // The pole is read back from the coefficients if it is ever needed.
+        self.theta[slot] = f64::NAN;
+        self.num_started += 1;
+        true
+    }
+
+    /// The column a mode starting from rest goes to: its own when that is among the emptiest.
+    fn column_for(&self, mode: usize) -> usize {
+        let fewest = self.live.iter().copied().min().unwrap_or(0);
+        (0..COLUMNS)
+            .map(|i| (mode + i) % COLUMNS)
+            .find(|&c| self.live[c] == fewest)
+            .unwrap_or(mode % COLUMNS)
+    }
+
+    /// Puts `mode` at the end of `column`, at rest, steady, with no coefficients yet. Returns its
+    /// slot.
+    fn push_slot(&mut self, mode: usize, column: usize) -> usize {
+        let slot = self.live[column] as usize * COLUMNS + column;
+        self.live[column] += 1;
+        self.clear_slot(slot);
         self.mode_of_slot[slot] = mode as u32;
         self.slot_of_mode[mode] = slot as u32;
-        self.num_started += 1;
         self.update_rows();
-        true
+        slot
     }
 
     /// Sets the coefficients of every live mode to those of the pole `pole_of(mode) = (theta,
     /// delta)` (angle in radians per sample, radius `exp(-delta)`; see
     /// [`ModeCoeffs::from_angle_radius`]), computed for all modes at once.
+    ///
+    /// Dormant modes take their new poles from now on, their state carried with the old ones up
+    /// to now.
     pub fn set_poles_with(&mut self, mut pole_of: impl FnMut(usize) -> (f64, f64)) {
         let n = self.rows_active * COLUMNS;
         for slot in 0..n {
@@ -138,12 +194,57 @@ impl ResonatorBank {
                 pole_of(mode as usize)
             };
         }
+        let now = self.clock;
+        for d in &mut self.dormant[..self.num_dormant] {
+            d.advance_to(now);
+            (d.theta, d.delta) = pole_of(d.mode as usize);
+        }
+        self.refresh_coeffs();
+    }
+
+    /// Recomputes every slot's coefficients from its pole, fades included.
+    fn refresh_coeffs(&mut self) {
+        let n = self.rows_active * COLUMNS;
+        for slot in 0..n {
+            if self.theta[slot].is_nan() {
+                (self.theta[slot], self.delta[slot]) = self.pole_of_slot(slot);
+            }
+        }
         coeffs_batch(
             &self.theta[..n],
             &self.delta[..n],
             &mut self.q_re[..n],
             &mut self.q_im[..n],
         );
+        if self.num_fading > 0 {
+            for slot in 0..n {
+                if self.fade_delta[slot] != 0.0 {
+                    self.set_slot_coeffs(slot);
+                }
+            }
+        }
+    }
+
+    /// Sets one slot's coefficients from its pole and fade.
+    fn set_slot_coeffs(&mut self, slot: usize) {
+        let c = ModeCoeffs::from_angle_radius(
+            self.theta[slot],
+            self.delta[slot] + self.fade_delta[slot],
+        );
+        self.q_re[slot] = c.q_re;
+        self.q_im[slot] = c.q_im;
+    }
+
+    /// The pole `(theta, delta)` of a slot without its fade: as set, or read back from the
+    /// coefficients the kernel runs (`p = 1 + q`).
+    fn pole_of_slot(&self, slot: usize) -> (f64, f64) {
+        if !self.theta[slot].is_nan() {
+            return (self.theta[slot], self.delta[slot]);
+        }
+        let (q_re, q_im) = (self.q_re[slot] as f64, self.q_im[slot] as f64);
+        // |p|^2 = 1 + 2 q_re + q_re^2 + q_im^2, kept exact near 1.
+        let delta = -0.5 * (2.0 * q_re + q_re * q_re + q_im * q_im).ln_1p();
+        (q_im.atan2(1.0 + q_re), delta - self.fade_delta[slot])
     }
 
     /// Sets the input gain of every live mode to `gain_of(mode)`.
@@ -168,6 +269,7 @@ impl ResonatorBank {
     /// each mode's output into its column's lane of `acc`.
     #[inline]
     pub fn process(&mut self, kernel: Kernel, input: Option<&[f32]>, acc: &mut [[f32; COLUMNS]]) {
+        self.clock += acc.len() as u64;
         let n = self.rows_active * COLUMNS;
         kernels::process(
             kernel,
@@ -183,8 +285,9 @@ impl ResonatorBank {
         );
     }
 
-    /// Stops every mode whose amplitude `|z|` is below `threshold` and re-packs the columns.
-    /// Returns the summed squared amplitude of the modes that remain.
+    /// Stops every computed mode whose amplitude `|z|` is below `threshold` and re-packs the
+    /// columns (fading modes finish their fade first). Returns the summed squared amplitude of the
+    /// steady modes that remain.
     pub fn retire_below(&mut self, threshold: f32) -> f32 {
         let threshold_sq = threshold * threshold;
         let mut energy = 0.0;
@@ -193,6 +296,9 @@ impl ResonatorBank {
             // Downwards, so the mode moved into a freed slot has already been checked.
             for row in (0..self.live[column] as usize).rev() {
                 let slot = row * COLUMNS + column;
+                if self.fade_delta[slot] != 0.0 {
+                    continue;
+                }
                 let e = self.re[slot] * self.re[slot] + self.im[slot] * self.im[slot];
                 // A state that is not a number is retired too.
                 if e.is_nan() || e < threshold_sq {
@@ -209,11 +315,19 @@ impl ResonatorBank {
         energy
     }
 
-    /// Summed squared amplitude `|z|^2` of the live modes.
+    /// Summed squared amplitude `|z|^2` of the live modes, computed or dormant.
     pub fn energy(&self) -> f32 {
-        self.live_slots()
+        let computed: f32 = self
+            .live_slots()
+            .filter(|&s| self.fade_delta[s] <= 0.0)
             .map(|s| self.re[s] * self.re[s] + self.im[s] * self.im[s])
-            .sum()
+            .sum();
+        let now = self.clock;
+        let dormant: f32 = self.dormant[..self.num_dormant]
+            .iter()
+            .map(|d| d.power_at(now))
+            .sum();
+        computed + dormant
     }
 
     /// Silences every mode.
@@ -225,6 +339,13 @@ impl ResonatorBank {
         self.rows_active = 0;
         self.num_started = 0;
         self.slot_of_mode.fill(NONE);
+        for d in &self.dormant[..self.num_dormant] {
+            self.dormant_of_mode[d.mode as usize] = NONE;
+        }
+        self.num_dormant = 0;
+        self.num_fading = 0;
+        self.num_fading_out = 0;
+        self.clock = 0;
     }
 
     /// Removes the mode in `slot`, moving its column's last live mode into the gap.
@@ -232,12 +353,21 @@ impl ResonatorBank {
         let column = slot % COLUMNS;
         let last = (self.live[column] as usize - 1) * COLUMNS + column;
         self.slot_of_mode[self.mode_of_slot[slot] as usize] = NONE;
+        if self.fade_delta[slot] != 0.0 {
+            self.num_fading -= 1;
+            // A mode fading out stays on as its record alone.
+            self.num_fading_out -= (self.fade_delta[slot] > 0.0) as usize;
+        }
         if last != slot {
             self.re[slot] = self.re[last];
             self.im[slot] = self.im[last];
             self.q_re[slot] = self.q_re[last];
             self.q_im[slot] = self.q_im[last];
             self.gain[slot] = self.gain[last];
+            self.theta[slot] = self.theta[last];
+            self.delta[slot] = self.delta[last];
+            self.fade_delta[slot] = self.fade_delta[last];
+            self.fade_end[slot] = self.fade_end[last];
             let moved = self.mode_of_slot[last];
             self.mode_of_slot[slot] = moved;
             self.slot_of_mode[moved as usize] = slot as u32;
@@ -253,6 +383,10 @@ impl ResonatorBank {
         self.q_re[slot] = 0.0;
         self.q_im[slot] = 0.0;
         self.gain[slot] = 0.0;
+        self.theta[slot] = 0.0;
+        self.delta[slot] = 0.0;
+        self.fade_delta[slot] = 0.0;
+        self.fade_end[slot] = 0;
         self.mode_of_slot[slot] = NONE;
     }
 
