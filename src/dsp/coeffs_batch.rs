@@ -14,7 +14,7 @@ const SERIES_DELTA_MAX: f64 = 0.5;
 
 /// `sin(h)` for `|h| <= pi / 2`: Taylor series to `h^15`.
 #[inline(always)]
-fn sin_series(h: f64) -> f64 {
+pub(crate) fn sin_series(h: f64) -> f64 {
     let h2 = h * h;
     let mut p = 1.0 / 1_307_674_368_000.0; // 1/15!
     p = p * -h2 + 1.0 / 6_227_020_800.0; // 1/13!
@@ -29,7 +29,7 @@ fn sin_series(h: f64) -> f64 {
 
 /// `cos(h)` for `|h| <= pi / 2`: Taylor series to `h^16`.
 #[inline(always)]
-fn cos_series(h: f64) -> f64 {
+pub(crate) fn cos_series(h: f64) -> f64 {
     let h2 = h * h;
     let mut p = 1.0 / 20_922_789_888_000.0; // 1/16!
     p = p * -h2 + 1.0 / 87_178_291_200.0; // 1/14!
@@ -42,7 +42,7 @@ fn cos_series(h: f64) -> f64 {
     p * -h2 + 1.0
 }
 
-/// `exp(-d) - 1` for `0 <= d <= 0.5`, with full relative precision near 0: Taylor series to `d^14`.
+/// `exp(-d) - 1` for `|d| <= 0.5`, with full relative precision near 0: Taylor series to `d^14`.
 #[inline(always)]
 fn expm1_neg_series(d: f64) -> f64 {
     let x = -d;
@@ -63,7 +63,7 @@ fn batch(theta: &[f64], delta: &[f64], q_re: &mut [f32], q_im: &mut [f32]) {
         .zip(q_re.iter_mut())
         .zip(q_im.iter_mut())
     {
-        let em1 = expm1_neg_series(d.min(SERIES_DELTA_MAX));
+        let em1 = expm1_neg_series(d.clamp(-SERIES_DELTA_MAX, SERIES_DELTA_MAX));
         let (s, c) = (sin_series(0.5 * t), cos_series(0.5 * t));
         let two_s2 = 2.0 * s * s;
         *qr = (em1 * (1.0 - two_s2) - two_s2) as f32;
@@ -78,8 +78,8 @@ fn batch_avx2(theta: &[f64], delta: &[f64], q_re: &mut [f32], q_im: &mut [f32]) 
 }
 
 /// Sets `q_re[i], q_im[i]` to [`ModeCoeffs::from_angle_radius`]`(theta[i], delta[i])` for every
-/// `i` (within about one `f32` rounding). `theta` must lie in `0..=2 pi MAX_FREQ_RATIO` and
-/// `delta` must not be negative. `(0, 0)` gives exactly `(0, 0)`.
+/// `i` (within about one `f32` rounding). `theta` must lie in `0..=2 pi MAX_FREQ_RATIO`; `delta`
+/// may be negative (a growing pole, as a mode fading in has). `(0, 0)` gives exactly `(0, 0)`.
 pub fn coeffs_batch(theta: &[f64], delta: &[f64], q_re: &mut [f32], q_im: &mut [f32]) {
     let n = theta.len();
     assert!(
@@ -98,7 +98,7 @@ pub fn coeffs_batch(theta: &[f64], delta: &[f64], q_re: &mut [f32], q_im: &mut [
     #[cfg(not(target_arch = "x86_64"))]
     batch(theta, delta, q_re, q_im);
     for i in 0..n {
-        if delta[i] > SERIES_DELTA_MAX {
+        if delta[i].abs() > SERIES_DELTA_MAX {
             let c = ModeCoeffs::from_angle_radius(theta[i], delta[i]);
             q_re[i] = c.q_re;
             q_im[i] = c.q_im;
@@ -117,7 +117,9 @@ mod tests {
         let mut theta = Vec::new();
         let mut delta = Vec::new();
         for i in 0..=400 {
-            for &d in &[0.0, 1e-8, 3e-6, 1e-4, 0.01, 0.3, 0.5, 0.7, 5.0] {
+            for &d in &[
+                0.0, 1e-8, 3e-6, 1e-4, 0.01, 0.3, 0.5, 0.7, 5.0, -1e-6, -0.03, -0.5, -0.9,
+            ] {
                 theta.push(theta_max * (i as f64 / 400.0).powi(3));
                 delta.push(d);
             }

@@ -113,6 +113,15 @@ impl Exciter {
         self.count == 0
     }
 
+    /// Bound on how much the strikes still under way can add to a mode's amplitude, relative to
+    /// its gain: the sum of their whole pulses' bounds ([`ExciterKind::peak_bound`]).
+    pub fn pending_bound(&self) -> f32 {
+        self.pulses[..self.count]
+            .iter()
+            .map(|p| p.amplitude.abs() * p.kind.peak_bound(p.len))
+            .sum()
+    }
+
     /// Starts a strike of `amplitude` lasting `len_samples` (at least 1) from the next sample
     /// rendered.
     pub fn strike(&mut self, kind: ExciterKind, amplitude: f32, len_samples: u32) {
