@@ -7,7 +7,8 @@
 //! and walks them loudest first against the upper envelope of the masking curves of the modes
 //! kept so far: a mode under the envelope is masked; a mode within the masking offset above it
 //! is kept but masks nothing. Sorting first keeps the cost near `O(N log N + N M)` with `M` the
-//! number of maskers (about `2 sqrt(N)`, seed 001), instead of `O(N^2)` pairs. The envelope at a
+//! number of maskers (about `2 sqrt(N)`, seed 001), instead of `O(N^2)` pairs; the sort here is a
+//! radix sort on quantised levels, linear in `N`. The envelope at a
 //! mode is evaluated against all maskers at once, eight lanes at a time.
 //!
 //! Storage is sized by [`MaskingPass::with_capacity`]; [`MaskingPass::run`] never allocates.
@@ -28,7 +29,7 @@ pub enum Verdict {
     Inaudible,
     /// Under the masking curve of candidate `by`.
     Masked {
-        /// Index of a candidate whose curve lies above this one.
+        /// Index of the candidate whose curve lies highest above this one.
         by: u32,
     },
 }
@@ -40,11 +41,26 @@ impl Verdict {
     }
 }
 
-/// Levels are sorted as whole multiples of this, in dB: finer than any decision the curves make.
-const SORT_STEP_DB: f32 = 1.0 / 256.0;
+/// Set in [`Verdict::Masked`]'s `by` when the masker is a prior one
+/// ([`MaskingPass::run_after`]).
+pub const PRIOR: u32 = 1 << 31;
 
-/// Highest level the sort keys distinguish, in dB SPL; anything louder sorts first.
-const SORT_CEILING_DB: f32 = 1000.0;
+/// Levels are sorted as whole multiples of this, in dB: finer than any decision the curves make.
+const SORT_STEP_DB: f32 = 1.0 / 128.0;
+
+/// Highest level the sort keys distinguish, in dB SPL; anything louder sorts first. With 16-bit
+/// keys the range below it is 512 dB.
+const SORT_CEILING_DB: f32 = 300.0;
+
+/// Turns counts into the start of each bucket.
+fn prefix_sums(counts: &mut [u32; 256]) {
+    let mut sum = 0;
+    for c in counts.iter_mut() {
+        let n = *c;
+        *c = sum;
+        sum += n;
+    }
+}
 
 /// Lanes of the envelope evaluation.
 const LANES: usize = 8;
@@ -52,8 +68,12 @@ const LANES: usize = 8;
 /// Scratch storage for the masking pass.
 #[derive(Debug, Clone, Default)]
 pub struct MaskingPass {
-    /// Sort keys: quantised level (loudest first) in the high half, candidate index in the low.
-    order: Vec<u64>,
+    /// Sort key of each candidate: its level quantised, loudest first.
+    keys: Vec<u16>,
+    /// Candidate indices in level order (loudest first) once sorted.
+    order: Vec<u32>,
+    /// Scratch for the radix sort.
+    scratch: Vec<u32>,
     /// Bark of each masker, padded to a whole number of lanes.
     masker_bark: Vec<f32>,
     /// `L - a_v` of each masker: its curve's peak.
@@ -62,20 +82,25 @@ pub struct MaskingPass {
     masker_upper_slope: Vec<f32>,
     /// Candidate index of each masker.
     masker_index: Vec<u32>,
+    /// Scratch: each masker's curve at the candidate in hand.
+    curve: Vec<f32>,
     /// Number of maskers found by the last run.
     num_maskers: usize,
 }
 
 impl MaskingPass {
-    /// Storage for passes over up to `capacity` candidates. Allocates.
+    /// Storage for passes over up to `capacity` candidates and maskers. Allocates.
     pub fn with_capacity(capacity: usize) -> Self {
         let padded = capacity.div_ceil(LANES) * LANES;
         Self {
-            order: Vec::with_capacity(capacity),
+            keys: vec![0; capacity],
+            order: vec![0; capacity],
+            scratch: vec![0; capacity],
             masker_bark: vec![0.0; padded],
             masker_peak: vec![f32::NEG_INFINITY; padded],
             masker_upper_slope: vec![0.0; padded],
             masker_index: vec![0; capacity],
+            curve: vec![f32::NEG_INFINITY; padded],
             num_maskers: 0,
         }
     }
@@ -90,6 +115,12 @@ impl MaskingPass {
         self.num_maskers
     }
 
+    /// The maskers of the last run, loudest first: candidate indices, or prior maskers' with
+    /// [`PRIOR`] set.
+    pub fn maskers(&self) -> &[u32] {
+        &self.masker_index[..self.num_maskers]
+    }
+
     /// Classifies every candidate `i` with level `level_db[i]` at `bark[i]` and threshold in quiet
     /// `threshold_db[i]` into `verdicts[i]`, with masking offset `offset_db` (`a_v`, seed 001).
     /// The loudest candidate is always audible. Candidates beyond the capacity are an error.
@@ -101,47 +132,81 @@ impl MaskingPass {
         offset_db: f32,
         verdicts: &mut [Verdict],
     ) {
+        self.run_after(
+            &[],
+            &[],
+            level_db,
+            bark,
+            threshold_db,
+            offset_db,
+            verdicts,
+            None,
+        );
+    }
+
+    /// As [`MaskingPass::run`], with maskers already known: prior masker `j` at `prior_bark[j]`
+    /// and `prior_level_db[j]` masks from the start, and a candidate it masks gets
+    /// `Masked { by: PRIOR | j }`. A candidate is only sure to be kept when it is louder than every
+    /// prior masker too. With `envelope_db`, the envelope of the masking curves (or the threshold
+    /// in quiet, if higher) at each audible candidate is written there, so the caller can tell
+    /// how far it is from being masked.
+    #[allow(clippy::too_many_arguments)] // two sets of parallel slices and the outputs
+    pub fn run_after(
+        &mut self,
+        prior_bark: &[f32],
+        prior_level_db: &[f32],
+        level_db: &[f32],
+        bark: &[f32],
+        threshold_db: &[f32],
+        offset_db: f32,
+        verdicts: &mut [Verdict],
+        mut envelope_db: Option<&mut [f32]>,
+    ) {
         let n = level_db.len();
         assert!(
             bark.len() == n && threshold_db.len() == n && verdicts.len() == n,
             "candidate slices differ in length"
         );
+        assert_eq!(prior_bark.len(), prior_level_db.len(), "prior maskers");
         assert!(
-            n <= self.capacity(),
-            "{n} candidates, capacity {}",
+            n + prior_bark.len() <= self.capacity(),
+            "{n} candidates and {} maskers, capacity {}",
+            prior_bark.len(),
             self.capacity()
         );
-        // Step 5: sort by level, loudest first. The order fits `Vec::with_capacity`, so neither
-        // the pushes nor the in-place sort allocate.
-        self.order.clear();
-        for (i, &l) in level_db.iter().enumerate() {
-            // NaN levels sort last and are below any threshold.
-            let key = if l.is_nan() {
-                u32::MAX
-            } else {
-                ((SORT_CEILING_DB - l) / SORT_STEP_DB).clamp(0.0, u32::MAX as f32 - 1.0) as u32
-            };
-            self.order.push(((key as u64) << 32) | i as u64);
-        }
-        self.order.sort_unstable();
-
         self.num_maskers = 0;
+        let mut loudest_prior = f32::NEG_INFINITY;
+        for (j, (&b, &l)) in prior_bark.iter().zip(prior_level_db).enumerate() {
+            self.push_masker(PRIOR as usize | j, b, l, offset_db);
+            loudest_prior = loudest_prior.max(l);
+        }
+        // Step 5: sort by level, loudest first.
+        self.sort(level_db);
         for rank in 0..n {
-            let i = (self.order[rank] & 0xffff_ffff) as usize;
+            let i = self.order[rank] as usize;
             let (l, b) = (level_db[i], bark[i]);
+            let loudest = rank == 0 && l >= loudest_prior;
             // Step 6: below the threshold of hearing (the loudest mode is always kept, so
             // pruning never silences a sounding object).
-            if rank > 0 && !(l > threshold_db[i]) {
+            if !loudest && !(l > threshold_db[i]) {
                 verdicts[i] = Verdict::Inaudible;
                 continue;
             }
             // Step 7, against the envelope of every masker so far at once.
             let envelope = self.envelope_at(b);
+            if let Some(out) = envelope_db.as_deref_mut() {
+                out[i] = envelope.max(threshold_db[i]);
+            }
             verdicts[i] = if l < envelope {
+                // The masker whose curve is highest here.
+                let j = self.curve[..self.num_maskers]
+                    .iter()
+                    .position(|&c| c == envelope)
+                    .unwrap_or(0);
                 Verdict::Masked {
-                    by: self.masker_above(b, l),
+                    by: self.masker_index[j],
                 }
-            } else if rank > 0 && l < envelope.max(threshold_db[i]) + offset_db {
+            } else if !loudest && l < envelope.max(threshold_db[i]) + offset_db {
                 // Close to a masker's curve, or to the threshold in quiet (the seed's curve
                 // includes it, eq. 4): heard, but too faint to mask.
                 Verdict::Audible { masker: false }
@@ -155,37 +220,65 @@ impl MaskingPass {
         self.masker_peak[..used].fill(f32::NEG_INFINITY);
     }
 
+    /// Sorts the candidates by level, loudest first, into `order`: a stable radix sort on the
+    /// levels quantised to [`SORT_STEP_DB`] (two passes of eight bits, linear in the count).
+    fn sort(&mut self, level_db: &[f32]) {
+        let n = level_db.len();
+        for (k, &l) in self.keys.iter_mut().zip(level_db) {
+            // Loudest first; NaN sorts last (and is below any threshold).
+            let steps = ((SORT_CEILING_DB - l) / SORT_STEP_DB).clamp(0.0, u16::MAX as f32);
+            *k = if l.is_nan() { u16::MAX } else { steps as u16 };
+        }
+        let mut counts = [0u32; 256];
+        for &k in &self.keys[..n] {
+            counts[(k & 0xff) as usize] += 1;
+        }
+        prefix_sums(&mut counts);
+        for i in 0..n {
+            let b = (self.keys[i] & 0xff) as usize;
+            self.scratch[counts[b] as usize] = i as u32;
+            counts[b] += 1;
+        }
+        let mut counts = [0u32; 256];
+        for &k in &self.keys[..n] {
+            counts[(k >> 8) as usize] += 1;
+        }
+        prefix_sums(&mut counts);
+        for j in 0..n {
+            let i = self.scratch[j];
+            let b = (self.keys[i as usize] >> 8) as usize;
+            self.order[counts[b] as usize] = i;
+            counts[b] += 1;
+        }
+    }
+
     /// Upper envelope of the maskers' curves at `bark` (seed 001 eq. 4 without the threshold in
-    /// quiet, which the caller has already applied).
+    /// quiet, which the caller has already applied). Leaves each masker's curve there in
+    /// `curve`.
     #[inline]
-    fn envelope_at(&self, bark: f32) -> f32 {
+    fn envelope_at(&mut self, bark: f32) -> f32 {
         let used = self.num_maskers.div_ceil(LANES) * LANES;
-        let mut lanes = [f32::NEG_INFINITY; LANES];
-        for ((mb, peak), su) in self.masker_bark[..used]
-            .chunks_exact(LANES)
-            .zip(self.masker_peak[..used].chunks_exact(LANES))
-            .zip(self.masker_upper_slope[..used].chunks_exact(LANES))
+        for (((c, mb), peak), su) in self.curve[..used]
+            .iter_mut()
+            .zip(&self.masker_bark[..used])
+            .zip(&self.masker_peak[..used])
+            .zip(&self.masker_upper_slope[..used])
         {
+            let below = LOWER_SLOPE_DB_PER_BARK * (mb - bark);
+            let above = su * (bark - mb);
+            *c = peak - if below > above { below } else { above };
+        }
+        let mut lanes = [f32::NEG_INFINITY; LANES];
+        for chunk in self.curve[..used].chunks_exact(LANES) {
             for l in 0..LANES {
-                let below = LOWER_SLOPE_DB_PER_BARK * (mb[l] - bark);
-                let above = su[l] * (bark - mb[l]);
-                let distance = if below > above { below } else { above };
-                let curve = peak[l] - distance;
-                lanes[l] = if curve > lanes[l] { curve } else { lanes[l] };
+                lanes[l] = if chunk[l] > lanes[l] {
+                    chunk[l]
+                } else {
+                    lanes[l]
+                };
             }
         }
         lanes.into_iter().fold(f32::NEG_INFINITY, f32::max)
-    }
-
-    /// Candidate index of the first masker whose curve at `bark` lies above `level_db`.
-    fn masker_above(&self, bark: f32, level_db: f32) -> u32 {
-        (0..self.num_maskers)
-            .find(|&j| {
-                let below = LOWER_SLOPE_DB_PER_BARK * (self.masker_bark[j] - bark);
-                let above = self.masker_upper_slope[j] * (bark - self.masker_bark[j]);
-                self.masker_peak[j] - below.max(above) > level_db
-            })
-            .map_or(0, |j| self.masker_index[j])
     }
 
     fn push_masker(&mut self, index: usize, bark: f32, level_db: f32, offset_db: f32) {
