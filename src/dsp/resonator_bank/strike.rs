@@ -1,0 +1,276 @@
+//! A strike on a bank whose modes are partly dormant.
+//!
+//! The kernels cannot drive a dormant mode, but an impulse or a mallet pulse is known in advance
+//! and the phasor is linear: a pulse `x_0 .. x_(L-1)` starting just after bank clock `t` leaves
+//! the state `p^L z(t) + g sum_j x_j p^(L-1-j)` when it ends, whatever `z(t)` was. So a dormant
+//! mode the strike leaves masked takes it analytically: its record is brought to `t` and the
+//! pulse's contribution referred to that instant, `g sum_j x_j p^-(j+1)`, is added (in closed form
+//! for the raised cosine, seed 000 eq. 4.5). Until the pulse has ended the record runs ahead of
+//! the truth by the part not yet played, so a mode woken then has that part taken back.
+
+use super::dormant::Dormant;
+use super::{ResonatorBank, NONE};
+use crate::dsp::masking::power_to_db;
+
+/// Most pulses kept track of at once (as many as one exciter overlaps).
+pub(super) const MAX_PULSES: usize = 4;
+
+/// Below this distance from 1 a geometric ratio is summed term by term rather than in closed
+/// form (the closed form divides by it).
+const NEAR_ONE: f64 = 1e-3;
+
+/// The kinds of pulse a dormant mode can take without being computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PulseShape {
+    /// A single sample.
+    Impulse,
+    /// A raised cosine `(A / L) (1 - cos(2 pi (j + 1/2) / L))` over `L` samples (the exciter's
+    /// mallet).
+    Mallet,
+}
+
+/// A pulse: its shape, its area and its length in samples.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pulse {
+    /// Shape.
+    pub shape: PulseShape,
+    /// Area (sum of the samples).
+    pub amplitude: f32,
+    /// Length in samples (1 for an impulse).
+    pub len: u32,
+}
+
+impl Pulse {
+    /// A pulse of nothing.
+    pub const NONE: Self = Self {
+        shape: PulseShape::Impulse,
+        amplitude: 0.0,
+        len: 1,
+    };
+
+    /// Samples it lasts.
+    fn samples(&self) -> u32 {
+        match self.shape {
+            PulseShape::Impulse => 1,
+            PulseShape::Mallet => self.len.max(1),
+        }
+    }
+
+    /// The constants of its response, worked out once per strike.
+    fn prepared(&self) -> Prepared {
+        let len = self.samples();
+        let w0 = std::f64::consts::TAU / len as f64;
+        Prepared {
+            amplitude: self.amplitude as f64,
+            len,
+            rot: C::cis(w0),
+            half_back: C::cis(-0.5 * w0),
+        }
+    }
+}
+
+/// A pulse's response constants.
+#[derive(Debug, Clone, Copy)]
+struct Prepared {
+    /// Area.
+    amplitude: f64,
+    /// Samples.
+    len: u32,
+    /// `e^(i w0)`, `w0 = 2 pi / L`.
+    rot: C,
+    /// `e^(-i w0 / 2)`.
+    half_back: C,
+}
+
+impl Prepared {
+    /// `sum_(j = a)^(b - 1) x_j w^(j + 1)` with `w = 1 / p`: the part of the pulse from sample `a`
+    /// to `b`, referred to the sample before it starts, for a mode of pole `p`.
+    fn response(&self, p: C, a: u32, b: u32) -> C {
+        let w = C::ONE.div(p);
+        let b = b.min(self.len);
+        if a >= b {
+            return C::ZERO;
+        }
+        if self.len == 1 {
+            return w.scale(self.amplitude);
+        }
+        // Raised cosine: 1 - (e^(i w0 (j + 1/2)) + e^(-i w0 (j + 1/2))) / 2, and
+        // e^(+-i w0 (j + 1/2)) w^(j + 1) = e^(-+i w0 / 2) (w e^(+-i w0))^(j + 1). The three
+        // ratios' powers differ only by whole turns of e^(+-i w0): worked out once.
+        let (first, span) = (w.powi(a + 1), w.powi(b - a));
+        let (ra, rs) = (self.rot.powi(a + 1), self.rot.powi(b - a));
+        let up = geometric(w.mul(self.rot), first.mul(ra), span.mul(rs), a, b);
+        let down = geometric(
+            w.mul(self.rot.conj()),
+            first.mul(ra.conj()),
+            span.mul(rs.conj()),
+            a,
+            b,
+        );
+        let sum = geometric(w, first, span, a, b)
+            .sub(self.half_back.mul(up).scale(0.5))
+            .sub(self.half_back.conj().mul(down).scale(0.5));
+        sum.scale(self.amplitude / self.len as f64)
+    }
+}
+
+/// `sum_(j = a)^(b - 1) u^(j + 1)`, given `u^(a + 1)` and `u^(b - a)`.
+fn geometric(u: C, first: C, span: C, a: u32, b: u32) -> C {
+    let one_minus = C::ONE.sub(u);
+    if one_minus.norm_sqr() < NEAR_ONE * NEAR_ONE {
+        let mut term = first;
+        let mut sum = C::ZERO;
+        for _ in a..b {
+            sum = sum.add(term);
+            term = term.mul(u);
+        }
+        return sum;
+    }
+    first.mul(C::ONE.sub(span)).div(one_minus)
+}
+
+impl ResonatorBank {
+    /// Every dormant mode (none may be fading: see [`ResonatorBank::wake_fading`]) takes `pulse`,
+    /// starting at the next sample, with input gain `gain_of(mode)`, without being computed. With
+    /// `due`, each is due for another look by the pruner now; otherwise its recheck time stands
+    /// (the pruner has set it knowing the strike).
+    pub fn absorb_strike(
+        &mut self,
+        pulse: Pulse,
+        due: bool,
+        mut gain_of: impl FnMut(usize) -> f32,
+    ) {
+        if self.num_dormant == 0 {
+            return;
+        }
+        let now = self.clock;
+        // Forget pulses that have ended; note this one.
+        let mut kept = 0;
+        for k in 0..self.num_pulses {
+            let (start, old) = self.pulses[k];
+            if start + (old.samples() as u64) > now {
+                self.pulses[kept] = self.pulses[k];
+                kept += 1;
+            }
+        }
+        if kept == MAX_PULSES {
+            self.pulses.rotate_left(1);
+            kept -= 1;
+        }
+        self.pulses[kept] = (now, pulse);
+        self.num_pulses = kept + 1;
+        let prepared = pulse.prepared();
+        for r in 0..self.num_dormant {
+            let d = &mut self.dormant[r];
+            if self.slot_of_mode[d.mode as usize] != NONE {
+                continue;
+            }
+            d.advance_to(now);
+            let (re, im) = d.state();
+            let gain = gain_of(d.mode as usize);
+            let added = prepared.response(C::new(d.p_re, d.p_im), 0, u32::MAX);
+            let z = C::new(re as f64, im as f64).add(added.scale(gain as f64));
+            let (re, im) = (z.re as f32, z.im as f32);
+            d.re = re;
+            d.im = im;
+            d.snap_db = power_to_db(re * re + im * im);
+            d.phase = 0.0;
+            d.log_gain = 0.0;
+            d.gain = gain;
+            if due {
+                self.recheck[r] = now;
+            }
+        }
+        if due {
+            self.earliest_recheck = self.earliest_recheck.min(now);
+        }
+    }
+
+    /// The state of record `d` (brought to now) with the unplayed part of any pulse it took
+    /// taken back.
+    pub(super) fn undo_pending_pulses(&self, d: &Dormant, state: (f32, f32)) -> (f32, f32) {
+        let now = self.clock;
+        let mut z = C::new(state.0 as f64, state.1 as f64);
+        let p = C::new(d.p_re, d.p_im);
+        for &(start, pulse) in &self.pulses[..self.num_pulses] {
+            let played = now.saturating_sub(start);
+            if played >= pulse.samples() as u64 {
+                continue;
+            }
+            // The record holds p^k (z + g sum_all); the truth is p^k (z + g sum_(j<k)).
+            let ahead = pulse.prepared().response(p, played as u32, u32::MAX);
+            z = z.sub(p.powi(played as u32).mul(ahead).scale(d.gain as f64));
+        }
+        (z.re as f32, z.im as f32)
+    }
+}
+
+/// A complex number in `f64`, for the few operations above.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct C {
+    re: f64,
+    im: f64,
+}
+
+impl C {
+    const ZERO: Self = Self { re: 0.0, im: 0.0 };
+    const ONE: Self = Self { re: 1.0, im: 0.0 };
+
+    fn new(re: f64, im: f64) -> Self {
+        Self { re, im }
+    }
+
+    /// `e^(i x)`.
+    fn cis(x: f64) -> Self {
+        let (s, c) = x.sin_cos();
+        Self { re: c, im: s }
+    }
+
+    fn add(self, o: Self) -> Self {
+        Self::new(self.re + o.re, self.im + o.im)
+    }
+
+    fn sub(self, o: Self) -> Self {
+        Self::new(self.re - o.re, self.im - o.im)
+    }
+
+    fn mul(self, o: Self) -> Self {
+        Self::new(
+            self.re * o.re - self.im * o.im,
+            self.re * o.im + self.im * o.re,
+        )
+    }
+
+    fn div(self, o: Self) -> Self {
+        let n = o.norm_sqr();
+        Self::new(
+            (self.re * o.re + self.im * o.im) / n,
+            (self.im * o.re - self.re * o.im) / n,
+        )
+    }
+
+    fn conj(self) -> Self {
+        Self::new(self.re, -self.im)
+    }
+
+    fn scale(self, k: f64) -> Self {
+        Self::new(self.re * k, self.im * k)
+    }
+
+    fn norm_sqr(self) -> f64 {
+        self.re * self.re + self.im * self.im
+    }
+
+    /// `self^n` by repeated squaring.
+    fn powi(self, mut n: u32) -> Self {
+        let (mut base, mut acc) = (self, Self::ONE);
+        while n > 0 {
+            if n & 1 == 1 {
+                acc = acc.mul(base);
+            }
+            base = base.mul(base);
+            n >>= 1;
+        }
+        acc
+    }
+}

@@ -1,0 +1,336 @@
+//! Packing: modes keep their columns and states however the bank is re-packed.
+
+use super::*;
+
+fn coeffs(mode: usize) -> ModeCoeffs {
+    ModeCoeffs::from_freq_decay(48_000.0, 100.0 + 37.0 * mode as f64, 3.0 + mode as f64)
+}
+
+#[test]
+fn repacking_keeps_each_mode_with_its_state() {
+    let mut bank = ResonatorBank::new(100);
+    for m in 0..100 {
+        bank.activate(m, coeffs(m), 1.0 + m as f32);
+    }
+    let mut acc = vec![[0.0; COLUMNS]; 32];
+    let input: Vec<f32> = (0..32).map(|n| if n == 0 { 1.0 } else { 0.0 }).collect();
+    bank.process(Kernel::Scalar, Some(&input), &mut acc);
+    let before: Vec<_> = (0..100).map(|m| bank.state(m).unwrap()).collect();
+    // Silence every third mode, then retire the silent ones.
+    let mut kept = bank.clone();
+    for m in (0..100).filter(|m| m % 3 == 0) {
+        let slot = kept.slot_of_mode[m] as usize;
+        kept.re[slot] = 0.0;
+        kept.im[slot] = 0.0;
+    }
+    kept.retire_below(1e-10);
+    for (m, state) in before.iter().enumerate() {
+        if m % 3 == 0 {
+            assert!(!kept.is_live(m), "mode {m} should be retired");
+        } else {
+            assert_eq!(kept.state(m), Some(*state), "mode {m} lost its state");
+            assert_eq!(
+                kept.slot_of_mode[m] as usize % COLUMNS,
+                m % COLUMNS,
+                "mode {m} changed column"
+            );
+        }
+    }
+    assert_eq!(kept.num_live(), 100 - 34);
+}
+
+#[test]
+fn skipped_modes_do_not_leave_lanes_empty() {
+    // Only even modes sound, as when a string is struck at its middle.
+    let mut bank = ResonatorBank::new(256);
+    for m in (0..256).step_by(2) {
+        bank.activate(m, coeffs(m), 1.0);
+    }
+    assert_eq!(bank.live, [16; COLUMNS]);
+    assert_eq!(bank.num_computed(), 128);
+}
+
+mod dormant {
+    use super::super::FADE_DEPTH_NEPERS;
+    use super::*;
+    use std::f64::consts::TAU;
+
+    const RATE: f64 = 48_000.0;
+
+    fn pole(m: usize, pitch: f64) -> (f64, f64) {
+        let f = pitch * (100.0 + 173.0 * m as f64);
+        (TAU * f / RATE, (2.0 + m as f64) / RATE)
+    }
+
+    /// A bank of `n` modes ringing after an impulse.
+    fn ringing(n: usize) -> ResonatorBank {
+        let mut bank = ResonatorBank::new(n);
+        for m in 0..n {
+            bank.activate(m, coeffs(m), 0.0);
+        }
+        bank.set_poles_with(|m| pole(m, 1.0));
+        bank.set_gains_with(|m| 1.0 / (1.0 + m as f32));
+        let mut acc = vec![[0.0; COLUMNS]; 64];
+        let mut x = vec![0.0; 64];
+        x[0] = 1.0;
+        bank.process(Kernel::Scalar, Some(&x), &mut acc);
+        bank
+    }
+
+    /// Runs `samples` (whole control periods) without input, ending fades on the way; returns
+    /// the summed output.
+    fn run(bank: &mut ResonatorBank, samples: usize, input: Option<&[f32]>) -> Vec<f32> {
+        let mut out = Vec::new();
+        for block in 0..samples / 64 {
+            let mut acc = vec![[0.0; COLUMNS]; 64];
+            bank.process(Kernel::Scalar, input.filter(|_| block == 0), &mut acc);
+            bank.finish_fades();
+            out.extend(acc.iter().map(|a| a.iter().sum::<f32>()));
+        }
+        out
+    }
+
+    fn assert_same_states(a: &ResonatorBank, b: &ResonatorBank, n: usize) {
+        for m in 0..n {
+            let (x, y) = (a.state(m).unwrap(), b.state(m).unwrap());
+            let scale = y.0.hypot(y.1);
+            assert!(
+                (x.0 - y.0).abs() < 1e-4 * scale && (x.1 - y.1).abs() < 1e-4 * scale,
+                "mode {m}: {x:?} vs {y:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_mode_switched_off_and_on_returns_in_phase() {
+        let mut pruned = ringing(20);
+        let mut reference = pruned.clone();
+        for m in [3, 7, 11] {
+            pruned.switch_off(m, 256, 0, 0);
+        }
+        assert_eq!(pruned.num_fading(), 3);
+        run(&mut pruned, 512, None);
+        run(&mut reference, 512, None);
+        assert_eq!(pruned.num_dormant(), 3);
+        assert_eq!(pruned.num_active(), 17);
+        assert_eq!(pruned.num_live(), 20);
+        // Dormant, the mode's level follows its decay.
+        pruned.for_each_dormant(u64::MAX, |d| {
+            let (re, im) = reference.state(d.mode).unwrap();
+            let want = 10.0 * (re * re + im * im).log10();
+            assert!(
+                (d.level_db - want).abs() < 0.01,
+                "mode {}: {} dB, expected {want}",
+                d.mode,
+                d.level_db
+            );
+        });
+        for m in [3, 7, 11] {
+            pruned.switch_on(m, 256);
+        }
+        run(&mut pruned, 5 * 64, None);
+        run(&mut reference, 5 * 64, None);
+        assert_eq!(pruned.num_fading(), 0);
+        assert_same_states(&pruned, &reference, 20);
+    }
+
+    #[test]
+    fn fades_are_smooth_envelopes() {
+        let mut pruned = ringing(1);
+        let mut reference = pruned.clone();
+        pruned.switch_off(0, 256, 0, 0);
+        let (x, y) = (run(&mut pruned, 512, None), run(&mut reference, 512, None));
+        // The reference under an exponential envelope 60 dB deep over 256 samples.
+        for n in 0..256 {
+            let env = (-FADE_DEPTH_NEPERS * (n + 1) as f64 / 256.0).exp() as f32;
+            assert!(
+                (x[n] - env * y[n]).abs() < 1e-5,
+                "sample {n}: {} vs {}",
+                x[n],
+                env * y[n]
+            );
+        }
+        assert!(x[256..].iter().all(|&v| v == 0.0));
+        assert_eq!(pruned.num_active(), 0);
+        assert_eq!(pruned.num_live(), 1);
+    }
+
+    #[test]
+    fn a_strike_on_woken_modes_sounds_as_if_they_had_never_slept() {
+        let n = 30;
+        let mut pruned = ringing(n);
+        let mut reference = pruned.clone();
+        for m in (0..n).step_by(2) {
+            pruned.switch_off(m, 128, 0, 0);
+        }
+        run(&mut pruned, 640, None);
+        run(&mut reference, 640, None);
+        // A pitch change while dormant.
+        pruned.set_poles_with(|m| pole(m, 1.05));
+        reference.set_poles_with(|m| pole(m, 1.05));
+        run(&mut pruned, 640, None);
+        run(&mut reference, 640, None);
+        // One mode fading back in, one fading out, the rest dormant, when the strike comes.
+        pruned.switch_on(4, 256);
+        pruned.switch_off(5, 256, 0, 0);
+        let mut before: Vec<f32> = run(&mut pruned, 64, None)
+            .iter()
+            .zip(run(&mut reference, 64, None))
+            .map(|(a, b)| a - b)
+            .collect();
+        // The strike comes between control periods: fades started there end between them.
+        let (mut a, mut b) = ([[0.0; COLUMNS]; 23], [[0.0; COLUMNS]; 23]);
+        pruned.process(Kernel::Scalar, None, &mut a);
+        reference.process(Kernel::Scalar, None, &mut b);
+        before.extend(
+            a.iter()
+                .zip(&b)
+                .map(|(a, b)| a.iter().sum::<f32>() - b.iter().sum::<f32>()),
+        );
+        pruned.wake_all();
+        assert_eq!(pruned.num_dormant(), 0);
+        assert_eq!(pruned.num_active(), n);
+        assert_eq!(pruned.num_woken(), n as u64 / 2 + 1);
+        let mut strike = vec![0.0; 64];
+        strike[0] = 0.7;
+        strike[1] = -0.2;
+        // Back onto the control grid, which fades started by the strike do not keep to.
+        let first = |bank: &mut ResonatorBank| {
+            let mut acc = [[0.0; COLUMNS]; 41];
+            bank.process(Kernel::Scalar, Some(&strike[..41]), &mut acc);
+            bank.finish_fades();
+            let mut out: Vec<f32> = acc.iter().map(|a| a.iter().sum::<f32>()).collect();
+            out.extend(run(bank, 1024, None));
+            out
+        };
+        let x = first(&mut pruned);
+        let y = first(&mut reference);
+        // Ghosts have joined their modes: the states are the reference's.
+        assert_eq!(pruned.num_fading(), 0);
+        assert_same_states(&pruned, &reference, n);
+        // The woken modes took the strike at full gain from its first sample (it cancels in
+        // the difference), and their old ringing comes back without a step: across the wake the
+        // difference moves no more than it does from sample to sample before it.
+        let after: Vec<f32> = x.iter().zip(&y).map(|(a, b)| a - b).collect();
+        let typical = before
+            .windows(2)
+            .fold(0.0f32, |a, w| a.max((w[1] - w[0]).abs()));
+        let across = (after[0] - before[before.len() - 1]).abs();
+        assert!(
+            across <= 1.5 * typical,
+            "the difference steps by {across} at the wake, by at most {typical} before"
+        );
+        assert!(after[1000..].iter().all(|d| d.abs() < 1e-4));
+    }
+}
+
+mod strike {
+    use super::super::{Pulse, PulseShape};
+    use super::*;
+    use crate::dsp::{Exciter, ExciterKind};
+    use std::f64::consts::TAU;
+
+    const RATE: f64 = 48_000.0;
+
+    fn ringing(n: usize) -> ResonatorBank {
+        let mut bank = ResonatorBank::new(n);
+        for m in 0..n {
+            bank.activate(m, coeffs(m), 0.0);
+        }
+        // Slow and fast decays, low and high modes (one near the pulse's own frequency).
+        bank.set_poles_with(|m| {
+            let f = 40.0 + 397.0 * m as f64;
+            (TAU * f / RATE, (1.0 + 40.0 * (m % 3) as f64) / RATE)
+        });
+        bank.set_gains_with(|m| 0.5 / (1.0 + m as f32));
+        let mut acc = vec![[0.0; COLUMNS]; 64];
+        let mut x = vec![0.0; 64];
+        x[0] = 1.0;
+        bank.process(Kernel::Scalar, Some(&x), &mut acc);
+        bank
+    }
+
+    fn gain(m: usize) -> f32 {
+        0.8 - 0.03 * m as f32
+    }
+
+    /// Strikes both banks with `kind` over `len` samples, the pruned one with its odd modes
+    /// dormant (taking the strike analytically), wakes everything `wake_after` samples into the
+    /// pulse, and compares the states once the ghosts have joined.
+    fn check(kind: ExciterKind, len: u32, wake_after: usize) {
+        let n = 24;
+        let mut pruned = ringing(n);
+        let mut reference = pruned.clone();
+        for m in (1..n).step_by(2) {
+            pruned.switch_off(m, 64, 0, 0);
+        }
+        for bank in [&mut pruned, &mut reference] {
+            let mut acc = vec![[0.0; COLUMNS]; 128];
+            bank.process(Kernel::Scalar, None, &mut acc);
+            bank.finish_fades();
+        }
+        assert_eq!(pruned.num_dormant(), n / 2);
+        let mut exciter = Exciter::new(3);
+        exciter.strike(kind, 0.7, len);
+        let mut x = vec![0.0; 2048];
+        exciter.render(&mut x);
+        let shape = match kind {
+            ExciterKind::Impulse => PulseShape::Impulse,
+            _ => PulseShape::Mallet,
+        };
+        reference.set_gains_with(gain);
+        pruned.set_gains_with(gain);
+        pruned.absorb_strike(
+            Pulse {
+                shape,
+                amplitude: 0.7,
+                len,
+            },
+            true,
+            gain,
+        );
+        let mut pos = 0;
+        for bank in [&mut pruned, &mut reference] {
+            let mut acc = vec![[0.0; COLUMNS]; wake_after];
+            bank.process(Kernel::Scalar, Some(&x[..wake_after]), &mut acc);
+        }
+        pos += wake_after;
+        pruned.wake_all();
+        // On in control periods, ending fades as the engine does.
+        for bank in [&mut pruned, &mut reference] {
+            for chunk in x[pos..].chunks(64) {
+                let mut acc = vec![[0.0; COLUMNS]; chunk.len()];
+                bank.process(Kernel::Scalar, Some(chunk), &mut acc);
+                bank.finish_fades();
+            }
+        }
+        assert_eq!(pruned.num_fading(), 0);
+        for m in 0..n {
+            let (a, b) = (pruned.state(m).unwrap(), reference.state(m).unwrap());
+            let scale = b.0.hypot(b.1).max(1e-3);
+            assert!(
+                (a.0 - b.0).abs() < 2e-4 * scale && (a.1 - b.1).abs() < 2e-4 * scale,
+                "{kind:?} over {len}, woken after {wake_after}: mode {m}: {a:?} vs {b:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn dormant_modes_take_an_impulse_analytically() {
+        check(ExciterKind::Impulse, 1, 64);
+    }
+
+    #[test]
+    fn dormant_modes_take_a_mallet_analytically() {
+        for len in [2, 15, 121, 600] {
+            check(ExciterKind::Mallet, len, 700);
+        }
+    }
+
+    #[test]
+    fn a_mode_woken_during_a_pulse_it_took_gets_only_what_was_played() {
+        for (len, after) in [(15, 7), (600, 64), (600, 599)] {
+            check(ExciterKind::Mallet, len, after);
+        }
+    }
+}
