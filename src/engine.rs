@@ -13,9 +13,11 @@
 //! from the last reset, and note events land on their exact sample, so the output does not depend
 //! on how the host cuts the stream into blocks.
 
+mod budget;
 mod controls;
 mod position;
 mod prepared;
+mod pruning;
 mod stereo;
 mod voice;
 
@@ -26,6 +28,8 @@ pub use controls::{
 };
 pub use position::{PositionMap, PositionWeights};
 pub use prepared::{PreparedBank, TARGET_PEAK};
+use pruning::Pruner;
+pub use pruning::PruningStats;
 use stereo::lane_weights;
 use voice::{PendingStrike, Tuning, Voice, VoiceOverrides, VoiceState};
 
@@ -262,6 +266,12 @@ pub struct EngineStats {
     pub live_modes: usize,
     /// Modes the kernels advance per sample (live modes plus row padding).
     pub computed_modes: usize,
+    /// Live modes switched off by pruning or the budget, their state carried analytically.
+    pub dormant_modes: usize,
+    /// Modes fading in or out.
+    pub fading_modes: usize,
+    /// Mode-samples computed since the engine was prepared (row padding included).
+    pub computed_mode_samples: u64,
 }
 
 /// Smoothed values and ramps that change on control ticks.
@@ -331,6 +341,10 @@ pub struct Engine {
     ended: Vec<EndedVoice>,
     /// Sample offset within the current `process` call.
     block_pos: u32,
+    /// Perceptual pruning.
+    pruner: Pruner,
+    /// The computation budget.
+    budget: budget::Budget,
 }
 
 impl Engine {
@@ -371,6 +385,8 @@ impl Engine {
             excitation: Vec::new(),
             ended: Vec::new(),
             block_pos: 0,
+            pruner: Pruner::new(),
+            budget: budget::Budget::default(),
         }
     }
 
@@ -387,6 +403,7 @@ impl Engine {
         self.excitation = vec![0.0; CONTROL_PERIOD];
         self.ended = Vec::with_capacity(MAX_ENDED);
         self.allocate_voices();
+        self.budget.calibrate(self.kernel, self.sample_rate_hz);
         self.reset();
     }
 
@@ -416,6 +433,7 @@ impl Engine {
             .map(|i| Voice::new(n, SEED ^ (i as u32 + 1)))
             .collect();
         self.input_voice = Some(Voice::new(n, SEED ^ 0xFFFF));
+        self.pruner.reserve(self.voices.len() + 1, n);
         self.decay = vec![0.0; n];
         self.tilted_decay = vec![0.0; n];
     }
@@ -431,6 +449,7 @@ impl Engine {
         self.input_heard = false;
         self.input_dormant = true;
         self.rng = Rng::new(SEED);
+        self.pruner.forget();
         // A reset ends every note for the host too: nothing left to report.
         self.ended.clear();
         let (log_damping, tilt) = self.damping_targets();
@@ -470,7 +489,8 @@ impl Engine {
         self.kernel
     }
 
-    /// Uses `kernel` from now on (it must be supported by this CPU).
+    /// Uses `kernel` from now on (it must be supported by this CPU), measuring its cost for the
+    /// automatic budget (about a millisecond).
     pub fn set_kernel(&mut self, kernel: Kernel) {
         assert!(
             kernel.is_supported(),
@@ -478,6 +498,9 @@ impl Engine {
             kernel.name()
         );
         self.kernel = kernel;
+        if !self.voices.is_empty() {
+            self.budget.calibrate(kernel, self.sample_rate_hz);
+        }
     }
 
     /// Sample rate in Hz.
@@ -492,6 +515,9 @@ impl Engine {
             s.voices += v.is_sounding() as usize;
             s.live_modes += v.modes.num_live();
             s.computed_modes += v.modes.num_computed();
+            s.dormant_modes += v.modes.num_dormant();
+            s.fading_modes += v.modes.num_fading();
+            s.computed_mode_samples += v.modes.computed_mode_samples();
         }
         s
     }

@@ -196,6 +196,21 @@ pub struct ModalParams {
     pub mpe: BoolParam,
     #[id = "mpebnd"]
     pub mpe_bend_range: FloatParam,
+    /// Perceptual pruning: masked and inaudible modes are not computed.
+    #[id = "prune"]
+    pub pruning: BoolParam,
+    #[id = "maskav"]
+    pub masking_offset: FloatParam,
+    #[id = "spl"]
+    pub playback_level: FloatParam,
+    #[id = "prfrm"]
+    pub analysis_frame: FloatParam,
+    /// Most modes computed at once; 0 = no cap.
+    #[id = "budget"]
+    pub mode_budget: IntParam,
+    /// Automatic budget: share of real time the synthesis may take; 0 = off.
+    #[id = "load"]
+    pub target_load: FloatParam,
 }
 
 fn percent(name: &str, default: f32) -> FloatParam {
@@ -348,6 +363,37 @@ impl ModalParams {
             )
             .with_unit(" st")
             .with_step_size(1.0),
+            pruning: BoolParam::new("Pruning", false),
+            masking_offset: decibels("Masking offset", 5.0, 0.0, 20.0),
+            playback_level: decibels("Playback level", 90.0, 40.0, 120.0).with_unit(" dB SPL"),
+            analysis_frame: FloatParam::new(
+                "Pruning frame",
+                20.0,
+                FloatRange::Linear {
+                    min: 2.0,
+                    max: 100.0,
+                },
+            )
+            .with_unit(" ms")
+            .with_step_size(1.0),
+            mode_budget: IntParam::new(
+                "Mode budget",
+                0,
+                IntRange::Linear {
+                    min: 0,
+                    max: 100_000,
+                },
+            ),
+            target_load: FloatParam::new(
+                "Target load",
+                0.0,
+                FloatRange::Linear {
+                    min: 0.0,
+                    max: 100.0,
+                },
+            )
+            .with_unit(" %")
+            .with_step_size(1.0),
         }
     }
 
@@ -438,6 +484,12 @@ impl ModalParams {
             width: self.width.value(),
             output_gain_db: self.output_gain.value(),
             input_gain_db: self.input_gain.value(),
+            pruning: self.pruning.value(),
+            masking_offset_db: self.masking_offset.value(),
+            playback_level_db_spl: self.playback_level.value(),
+            analysis_frame_ms: self.analysis_frame.value(),
+            mode_budget: self.mode_budget.value().max(0) as usize,
+            target_load_pct: self.target_load.value(),
         }
     }
 }

@@ -120,6 +120,22 @@ pub struct Controls {
     pub output_gain_db: f32,
     /// Level of an audio input driving the modes, in dB.
     pub input_gain_db: f32,
+    /// Perceptual pruning (seed 001): modes below the threshold of hearing or masked by louder
+    /// ones are not computed.
+    pub pruning: bool,
+    /// Masking offset `a_v` of pruning in dB: how far below a masker's curve a mode must lie to be
+    /// dropped; larger prunes less (5 dB was transparent in seed 001).
+    pub masking_offset_db: f32,
+    /// Playback level: dB SPL of a full-scale sine. Calibrates mode levels against the threshold
+    /// of hearing and the level-dependent masking curves.
+    pub playback_level_db_spl: f32,
+    /// How often pruning looks at the modes, in ms (rounded to whole control periods).
+    pub analysis_frame_ms: f32,
+    /// Most modes computed at once, the most energetic kept (seed 000 section 5.5); 0 = no cap.
+    pub mode_budget: usize,
+    /// Automatic budget: cap the modes so the estimated synthesis cost stays under this share of
+    /// real time, in percent, from the engine's own cost measured when prepared; 0 = off.
+    pub target_load_pct: f32,
 }
 
 impl Default for Controls {
@@ -145,6 +161,12 @@ impl Default for Controls {
             width: 0.5,
             output_gain_db: 0.0,
             input_gain_db: 0.0,
+            pruning: false,
+            masking_offset_db: 5.0,
+            playback_level_db_spl: 90.0,
+            analysis_frame_ms: 20.0,
+            mode_budget: 0,
+            target_load_pct: 0.0,
         }
     }
 }
@@ -218,7 +240,37 @@ pub const NUMERIC_CONTROLS: &[ControlSpec] = &[
     spec!("width", "", 0.0, 1.0, width),
     spec!("output_gain_db", "dB", -60.0, 12.0, output_gain_db),
     spec!("input_gain_db", "dB", -60.0, 24.0, input_gain_db),
+    ControlSpec {
+        name: "pruning",
+        unit: "",
+        min: 0.0,
+        max: 1.0,
+        integer: true,
+        get: |c| c.pruning as u8 as f32,
+        set: |c, v| c.pruning = v >= 0.5,
+    },
+    spec!("masking_offset_db", "dB", 0.0, 20.0, masking_offset_db),
+    spec!(
+        "playback_level_db_spl",
+        "dB SPL",
+        40.0,
+        120.0,
+        playback_level_db_spl
+    ),
+    spec!("analysis_frame_ms", "ms", 2.0, 100.0, analysis_frame_ms),
+    spec!(
+        "mode_budget",
+        "modes",
+        0.0,
+        MAX_MODE_BUDGET as f32,
+        mode_budget,
+        true
+    ),
+    spec!("target_load_pct", "%", 0.0, 100.0, target_load_pct),
 ];
+
+/// Largest fixed mode budget.
+pub const MAX_MODE_BUDGET: usize = 1_000_000;
 
 /// Range of material Q.
 pub const MATERIAL_Q_RANGE: (f32, f32) = (1.0, 100_000.0);

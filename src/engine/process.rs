@@ -186,6 +186,7 @@ impl Engine {
             if v.state == VoiceState::Free && v.modes.num_live() == 0 {
                 continue;
             }
+            v.modes.finish_fades();
             if v.exciter.is_idle() && !(is_input && input_heard) {
                 // Each mode started gets an equal share of the threshold's energy, so all a
                 // voice ever drops adds up to less than the threshold. (Seed 000 section 5.4.2
@@ -220,6 +221,7 @@ impl Engine {
             let victim = self.quietest_sounding();
             self.voices[victim].state = VoiceState::Fading;
         }
+        self.prune_tick(input_heard);
     }
 
     fn apply_event(&mut self, event: NoteEvent) {
@@ -429,6 +431,7 @@ impl Engine {
             .max(1.0) as u32;
         let threshold = db_to_gain(c.truncation_db);
         let kind = c.exciter;
+        let pulse = self.wake_for_strike(i, kind, amplitude, len, &weights);
         self.voices[i].strike(
             &self.bank,
             &self.decay,
@@ -440,6 +443,7 @@ impl Engine {
             len,
             threshold,
         );
+        self.settle_strike(i, pulse, &weights);
     }
 
     /// Renders a run of samples within one control period and with no events inside.
@@ -493,11 +497,13 @@ impl Engine {
                 }
             }
             s.gain += (target_gain - s.gain) * gain_k;
-            let (mut sl, mut sr) = (0.0, 0.0);
-            for ((x, wl), wr) in a.iter().zip(&s.weights.0).zip(&s.weights.1) {
-                sl += x * wl;
-                sr += x * wr;
-            }
+            // Pairwise sums: independent adds, not a chain of eight (one per column).
+            const _: () = assert!(COLUMNS == 8);
+            let mix = |w: &[f32; COLUMNS]| {
+                let p: [f32; COLUMNS] = std::array::from_fn(|j| a[j] * w[j]);
+                ((p[0] + p[1]) + (p[2] + p[3])) + ((p[4] + p[5]) + (p[6] + p[7]))
+            };
+            let (sl, sr) = (mix(&s.weights.0), mix(&s.weights.1));
             *l = sl * s.gain;
             *r = sr * s.gain;
         }
@@ -571,6 +577,11 @@ impl Engine {
         };
         let acc = &mut self.acc[..n];
         if heard {
+            // Dormant modes cannot take input: compute them all again, in phase.
+            if v.modes.num_dormant() + v.modes.num_fading() > 0 {
+                v.modes.wake_all();
+                self.pruner.note_input();
+            }
             v.modes
                 .process(self.kernel, Some(&self.excitation[..n]), acc);
         } else if v.modes.num_live() > 0 {

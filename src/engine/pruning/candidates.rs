@@ -1,0 +1,162 @@
+//! The modes one analysis looks at, structure-of-arrays, with the levels and critical-band rates
+//! the masking pass needs.
+
+use std::f64::consts::TAU;
+
+use crate::dsp::masking::{power_to_db, PsychoTable, DB_PER_NEPER};
+use crate::dsp::pruning::Verdict;
+
+/// Candidate flag: computed and not to be switched off (fading, or its voice is being driven).
+pub(super) const LOCKED: u8 = 1;
+/// Candidate flag: dormant.
+pub(super) const DORMANT: u8 = 2;
+/// Candidate flag: dormant and below the truncation threshold: to be dropped.
+pub(super) const DROP: u8 = 4;
+/// Candidate flag: audible but beyond the budget.
+pub(super) const OVER_BUDGET: u8 = 8;
+
+/// The mode in a `voice << 24 | mode` pair.
+pub(super) const MODE_MASK: u32 = 0x00ff_ffff;
+
+/// How levels are read this analysis.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Reading {
+    /// dB SPL of a unit amplitude at the output.
+    pub calibration_db: f32,
+    /// Hz per radian per sample.
+    pub radians_to_hz: f64,
+    /// Whether the budget's energy ranking is wanted.
+    pub budget: bool,
+}
+
+impl Reading {
+    pub fn new(calibration_db: f32, sample_rate_hz: f64, budget: bool) -> Self {
+        Self {
+            calibration_db,
+            radians_to_hz: sample_rate_hz / TAU,
+            budget,
+        }
+    }
+}
+
+/// The candidates of one analysis.
+#[derive(Debug, Clone)]
+pub(super) struct Candidates {
+    /// Bark and threshold in quiet by frequency.
+    table: PsychoTable,
+    /// Level of each candidate in dB SPL.
+    pub level_db: Vec<f32>,
+    /// Critical-band rate of each candidate.
+    pub bark: Vec<f32>,
+    /// Threshold in quiet at each candidate, dB SPL.
+    pub threshold_db: Vec<f32>,
+    /// Power of each candidate in dB relative to full scale, before output gain.
+    pub raw_db: Vec<f32>,
+    /// How fast each candidate's level falls, dB per sample.
+    pub fall_db: Vec<f32>,
+    /// Pole angle of each candidate, radians per sample.
+    pub theta: Vec<f32>,
+    /// Energy still to come of each candidate in dB (seed 000 eq. 5.15), for the budget.
+    pub energy_db: Vec<f32>,
+    /// The masking envelope (or threshold in quiet) at each heard candidate, dB SPL.
+    pub envelope_db: Vec<f32>,
+    /// `voice << 24 | mode` of each candidate.
+    pub who: Vec<u32>,
+    /// Flags of each candidate.
+    pub flags: Vec<u8>,
+    /// The pass's verdicts.
+    pub verdicts: Vec<Verdict>,
+    /// Number in use.
+    pub len: usize,
+    /// Modes per voice: the stride of the per-mode tables.
+    pub stride: usize,
+    /// Bark and threshold in quiet of each voice's modes at its tuning (voice-major).
+    psycho: Vec<(f32, f32)>,
+    /// The voice generation each `psycho` entry was computed for.
+    psycho_generation: Vec<u32>,
+    /// One more than each mode's candidate index, or 0 (voice-major).
+    pub index_of: Vec<u32>,
+}
+
+impl Candidates {
+    /// Room for every mode of `num_voices` voices of `num_modes` modes. Allocates.
+    pub fn new(num_voices: usize, num_modes: usize) -> Self {
+        let n = num_voices * num_modes;
+        Self {
+            table: PsychoTable::new(),
+            level_db: vec![0.0; n],
+            bark: vec![0.0; n],
+            threshold_db: vec![0.0; n],
+            raw_db: vec![0.0; n],
+            fall_db: vec![0.0; n],
+            theta: vec![0.0; n],
+            energy_db: vec![0.0; n],
+            envelope_db: vec![0.0; n],
+            who: vec![0; n],
+            flags: vec![0; n],
+            verdicts: vec![Verdict::Inaudible; n],
+            len: 0,
+            stride: num_modes,
+            psycho: vec![(0.0, 0.0); n],
+            psycho_generation: vec![u32::MAX; n],
+            index_of: vec![0; n],
+        }
+    }
+
+    /// Adds mode `mode` of voice `voice` (of generation `generation`) with power `raw_db` (dB re
+    /// full scale) and pole `(theta, delta)`.
+    #[allow(clippy::too_many_arguments)] // the fields of one candidate
+    #[inline]
+    pub fn push(
+        &mut self,
+        voice: usize,
+        generation: u32,
+        mode: usize,
+        raw_db: f32,
+        theta: f64,
+        delta: f64,
+        flags: u8,
+        reading: &Reading,
+    ) {
+        // Bark and threshold in quiet follow the voice's tuning: kept until it changes.
+        let k = voice * self.stride + mode;
+        if self.psycho_generation[k] != generation {
+            self.psycho[k] = self.table.lookup((theta * reading.radians_to_hz) as f32);
+            self.psycho_generation[k] = generation;
+        }
+        let (bark, threshold_db) = self.psycho[k];
+        let i = self.len;
+        self.level_db[i] = raw_db + reading.calibration_db;
+        self.raw_db[i] = raw_db;
+        self.bark[i] = bark;
+        self.threshold_db[i] = threshold_db;
+        self.fall_db[i] = DB_PER_NEPER * delta as f32;
+        self.theta[i] = theta as f32;
+        if reading.budget {
+            // Seed 000 eq. 5.15 in dB, per-sample units: a^2 w^2 / (4 alpha (alpha^2 + w^2)).
+            let (w, a) = (theta as f32, (delta as f32).max(1e-12));
+            self.energy_db[i] = raw_db + power_to_db(w * w / (4.0 * a * (a * a + w * w)));
+        }
+        self.who[i] = ((voice as u32) << 24) | mode as u32;
+        self.flags[i] = flags;
+        self.index_of[k] = i as u32 + 1;
+        self.len += 1;
+    }
+
+    /// Voice and mode of candidate `i`.
+    pub fn voice_mode(&self, i: usize) -> (usize, usize) {
+        (
+            (self.who[i] >> 24) as usize,
+            (self.who[i] & MODE_MASK) as usize,
+        )
+    }
+
+    /// Empties the list, forgetting which modes were in it.
+    pub fn clear(&mut self) {
+        for i in 0..self.len {
+            let (voice, mode) = self.voice_mode(i);
+            self.index_of[voice * self.stride + mode] = 0;
+        }
+        self.len = 0;
+    }
+}
