@@ -506,6 +506,31 @@ impl Engine {
         }
     }
 
+    /// The notes of every voice sounding or fading out.
+    pub fn notes(&self) -> impl Iterator<Item = Note> + '_ {
+        self.voices
+            .iter()
+            .filter(|v| v.state != VoiceState::Free)
+            .map(|v| Note {
+                key: v.key,
+                channel: v.channel,
+                id: v.id,
+            })
+    }
+
+    /// Whether a voice sounds for the host's note `id`.
+    pub fn has_note_id(&self, id: i32) -> bool {
+        self.voices
+            .iter()
+            .any(|v| v.is_sounding() && v.id == Some(id))
+    }
+
+    /// Tunes the input voice to `key` (else the bank's root) until a note is played: the last key
+    /// the player struck, carried over to an engine built for a new bank.
+    pub fn set_last_key(&mut self, key: Option<u8>) {
+        self.last_key = key;
+    }
+
     /// Hands over the voices that stopped sounding during the last `process` calls (freed,
     /// choked, faded out after stealing, or taken over by a new note with another id), each
     /// with its sample offset in the call where it ended. Does not allocate.

@@ -30,7 +30,8 @@ const PROGRESS_STEPS: u64 = 1000;
 #[derive(Debug, Parser)]
 #[command(name = "modal-resonator", version, about)]
 struct Cli {
-    /// What to do; with none, plays the instrument standalone (as `play`).
+    /// What to do; with none, plays the instrument standalone (as `play`, taking its options:
+    /// `modal-resonator --backend dummy`).
     #[command(subcommand)]
     command: Option<Command>,
 }
@@ -94,7 +95,18 @@ struct RenderArgs {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    // Options with no subcommand go to the standalone: `modal-resonator --backend dummy`.
+    let argv: Vec<String> = std::env::args().skip(1).collect();
+    let standalone_options = argv
+        .first()
+        .is_some_and(|a| a.starts_with("--") && a != "--help" && a != "--version");
+    let cli = if standalone_options {
+        Cli {
+            command: Some(Command::Play { args: argv }),
+        }
+    } else {
+        Cli::parse()
+    };
     let result = match cli.command {
         Some(Command::Render(args)) => run_render(&args),
         Some(Command::Validate { files }) => run_validate(&files),

@@ -427,30 +427,33 @@ fn help_lists_the_subcommands() {
 #[test]
 fn the_standalone_runs_headless_with_the_dummy_backend() {
     // The standalone runs until stopped: start it, let it process for a while, then stop it.
-    let mut child = Command::new(env!("CARGO_BIN_EXE_modal-resonator"))
-        .args([
-            "play",
-            "--backend",
-            "dummy",
-            "--sample-rate",
-            "48000",
-            "--period-size",
-            "256",
-        ])
-        .env_remove("DISPLAY")
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("the binary runs");
-    std::thread::sleep(std::time::Duration::from_secs(2));
-    let still_running = child.try_wait().unwrap().is_none();
-    let _ = child.kill();
-    let out = child.wait_with_output().unwrap();
-    assert!(
-        still_running,
-        "the standalone stopped by itself: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    // Its options work after `play` and with no subcommand at all.
+    let options = [
+        "--backend",
+        "dummy",
+        "--sample-rate",
+        "48000",
+        "--period-size",
+        "256",
+    ];
+    for play in [&["play"][..], &[]] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_modal-resonator"))
+            .args(play.iter().chain(&options))
+            .env_remove("DISPLAY")
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("the binary runs");
+        std::thread::sleep(std::time::Duration::from_secs(2));
+        let still_running = child.try_wait().unwrap().is_none();
+        let _ = child.kill();
+        let out = child.wait_with_output().unwrap();
+        assert!(
+            still_running,
+            "{play:?}: the standalone stopped by itself: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
 }
 
 /// The broken banks of the format tests, each with the JSON path (or position) its error names.

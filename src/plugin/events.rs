@@ -156,13 +156,15 @@ impl<K: Kind> ModalPlugin<K> {
                         });
                     }
                 }
+                // Per-note pressure follows the pressure routing: it can damp one note; a strike
+                // position only matters when the note is struck, so it is not moved per note.
                 NoteEvent::PolyPressure {
                     timing,
                     voice_id,
                     channel,
                     key,
                     pressure,
-                } => {
+                } if pressure_damps => {
                     if let Some(note) = note_of(voice_id, channel, key) {
                         self.push(EngineEvent::Expression {
                             time: timing,
