@@ -33,12 +33,13 @@ use std::collections::HashSet;
 use serde_json::{json, Map};
 
 pub use error::FitError;
-pub use fidelity::{fidelity, resynthesize, Fidelity};
+pub use fidelity::{resynthesize, Fidelity};
 pub use report::{FitReport, ModeReport, RecordingReport};
 pub use wav::read_wav_recording;
 
-use self::analyse::{analyse, Analysis};
+use self::analyse::{analyse, prepare, Analysis};
 use self::combine::{combine, Combined};
+use self::fidelity::fidelity;
 use self::lsq::Shape;
 use crate::dsp::coeffs::{decay_to_t60_s, MAX_FREQ_RATIO};
 use crate::model::bank::{Bank, Mode, Position};
@@ -200,6 +201,35 @@ pub fn fit_bank(recordings: &[Recording], options: &FitOptions) -> Result<FitRes
     let bank = build_bank(recordings, options, &modes);
     let report = build_report(&analyses, options, &modes, &bank, modes_found);
     Ok(FitResult { bank, report })
+}
+
+/// How close `bank` comes to each of `recordings`: the log-spectral distance and level of the
+/// bank re-synthesised at the position named like the recording, as the fit's report gives it.
+/// For scoring a bank after editing, or a stored bank against the recordings it came from.
+pub fn compare(
+    bank: &Bank,
+    recordings: &[Recording],
+    options: &FitOptions,
+) -> Result<Vec<Fidelity>, FitError> {
+    options.check()?;
+    recordings
+        .iter()
+        .map(|r| {
+            let position = bank
+                .positions
+                .iter()
+                .position(|p| p.name == r.name)
+                .ok_or_else(|| FitError::BadOption {
+                    message: format!(
+                        "the bank has no position named \"{}\" to compare the recording with",
+                        r.name
+                    ),
+                })?;
+            let a = prepare(r, options)?;
+            let max_hz = options.max_hz(r.sample_rate_hz);
+            Ok(fidelity(bank, position, &a, options.min_hz, max_hz))
+        })
+        .collect()
 }
 
 /// The bank of `modes`, with the recordings and options in its `source`.

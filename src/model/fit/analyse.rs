@@ -45,6 +45,10 @@ const CLIP_LEVEL: f32 = 0.999;
 /// ... and this many in a row as clipping.
 const CLIP_RUN: usize = 3;
 
+/// A mode whose amplitude falls by less than this many nepers (10%) over the recording is a
+/// steady tone, not part of the ring.
+const STEADY_NEPERS: f64 = 0.1;
+
 /// A strike less than this many dB above the noise gets a warning.
 pub const NOISY_SNR_DB: f64 = 30.0;
 
@@ -127,6 +131,17 @@ impl Analysis {
 
 /// Finds the modes of `recording` within the options' frequency range.
 pub fn analyse(recording: &Recording, options: &FitOptions) -> Result<Analysis, FitError> {
+    let mut analysis = prepare(recording, options)?;
+    let max_hz = options.max_hz(recording.sample_rate_hz);
+    let max_candidates = 3 * options.max_modes + 16;
+    find_modes(&mut analysis, options.min_hz, max_hz, max_candidates);
+    drop_steady_tones(&mut analysis);
+    Ok(analysis)
+}
+
+/// Checks `recording`, finds its strike and noise floor, and warns of clipping and noise; finds
+/// no modes yet.
+pub fn prepare(recording: &Recording, options: &FitOptions) -> Result<Analysis, FitError> {
     let name = recording.name.clone();
     let rate_hz = recording.sample_rate_hz;
     if rate_hz < MIN_SAMPLE_RATE_HZ {
@@ -184,7 +199,7 @@ pub fn analyse(recording: &Recording, options: &FitOptions) -> Result<Analysis, 
 
     let whole = Spectrogram::new(&x, rate, window_len, hop, PAD);
     let noise = NoiseSpectrum::estimate(&whole, window_sums.0);
-    let mut analysis = Analysis {
+    Ok(Analysis {
         name,
         sample_rate_hz: rate,
         signal: x[strike.onset..end].to_vec(),
@@ -197,11 +212,7 @@ pub fn analyse(recording: &Recording, options: &FitOptions) -> Result<Analysis, 
         noise,
         window_sums,
         floor_override: options.noise_floor_db.map(|db| 10f64.powf(db / 20.0)),
-    };
-    let max_hz = options.max_hz(rate_hz);
-    let max_candidates = 3 * options.max_modes + 16;
-    find_modes(&mut analysis, options.min_hz, max_hz, max_candidates);
-    Ok(analysis)
+    })
 }
 
 /// The rounds of voting, tracking and joint fitting.
@@ -273,6 +284,34 @@ fn find_modes(a: &mut Analysis, min_hz: f64, max_hz: f64, max_candidates: usize)
         }
     }
     a.modes = modes;
+}
+
+/// Leaves out the modes that hardly decay over the whole recording, with a warning for each:
+/// mains hum, a fan or a whistle, not the object. A struck object's slowest modes still lose more
+/// than 10% of their amplitude over a recording of their ring.
+fn drop_steady_tones(a: &mut Analysis) {
+    let sound_s = a.signal.len() as f64 / a.sample_rate_hz;
+    let (steady, modes): (Vec<Found>, Vec<Found>) = a
+        .modes
+        .iter()
+        .partition(|m| m.decay_per_s * sound_s < STEADY_NEPERS);
+    if steady.is_empty() {
+        return;
+    }
+    for m in &steady {
+        a.warnings.push(format!(
+            "steady tone at {:.1} Hz left out: it decays by less than 10% over the {sound_s:.2} s \
+             of sound (hum or background noise?)",
+            m.freq_hz
+        ));
+    }
+    let shapes = shapes_of(&modes);
+    let amplitudes = a.amplitudes(&shapes);
+    a.modes = modes
+        .into_iter()
+        .zip(amplitudes)
+        .map(|(m, amplitude)| Found { amplitude, ..m })
+        .collect();
 }
 
 /// Frequencies voted for in `signal` between `min_hz` and `max_hz`, leaving out those within

@@ -3,9 +3,11 @@
 //!
 //! The score is the log-spectral distance over time: the RMS difference in dB between the two
 //! spectrograms, over the time-frequency cells where either stands above the recording's noise
-//! floor. Phases are ignored (the engine starts every mode in sine phase; a microphone hears each
-//! with its own), the level is not: a bank that reproduces the recording's spectrum and decays
-//! but not its level scores the level difference.
+//! floor and within 60 dB of the recording's loudest cell (the range a listener hears of one
+//! strike; below it the comparison would weigh window leakage and inaudible detail). Phases are
+//! ignored (the engine starts every mode in sine phase; a microphone hears each with its own),
+//! the level is not: a bank that reproduces the recording's spectrum and decays but not its
+//! level scores the level difference.
 
 use std::sync::Arc;
 
@@ -23,6 +25,9 @@ const FRAME_S: f64 = 0.04;
 /// Cells within this many dB of the noise floor count as silent in both spectrograms.
 const FLOOR_ABOVE_NOISE_DB: f64 = 6.0;
 
+/// Cells more than this many dB below the recording's loudest count as silent too.
+pub const DYNAMIC_RANGE_DB: f64 = 60.0;
+
 /// Quietest level the engine renders, in dBFS: far below any recording's noise.
 const TRUNCATION_DB: f32 = -140.0;
 
@@ -32,7 +37,8 @@ const KEY: u8 = 60;
 /// The comparison of a recording with the bank's re-synthesis.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Fidelity {
-    /// Log-spectral distance in dB: RMS over the cells above the noise floor.
+    /// Log-spectral distance in dB: RMS over the cells above the noise floor and within
+    /// [`DYNAMIC_RANGE_DB`] of the recording's loudest.
     pub lsd_db: f64,
     /// Energy of the re-synthesis over the recording's, in dB.
     pub level_db: f64,
@@ -87,12 +93,17 @@ pub fn fidelity(bank: &Bank, position: usize, a: &Analysis, min_hz: f64, max_hz:
     let rec = Spectrogram::new(&a.signal, rate, len, len / 2, 1);
     let syn = Spectrogram::new(&synth, rate, len, len / 2, 1);
     let bins = rec.bin_of(min_hz)..rec.bin_of(max_hz) + 1;
+    let loudest = rec
+        .power
+        .iter()
+        .flat_map(|frame| frame[bins.clone()].iter())
+        .fold(0.0f64, |a, &p| a.max(p));
+    let range_floor = loudest * 10f64.powf(-DYNAMIC_RANGE_DB / 10.0);
     let floors: Vec<f64> = bins
         .clone()
         .map(|b| {
-            a.noise_density(b as f64 * rec.bin_hz)
-                * sum_sq
-                * 10f64.powf(FLOOR_ABOVE_NOISE_DB / 10.0)
+            let noise = a.noise_density(b as f64 * rec.bin_hz) * sum_sq;
+            (noise * 10f64.powf(FLOOR_ABOVE_NOISE_DB / 10.0)).max(range_floor)
         })
         .collect();
     let (mut total, mut cells) = (0.0, 0usize);
