@@ -326,3 +326,165 @@ fn a_known_bank_is_recovered_from_noisy_renders() {
         );
     }
 }
+
+#[test]
+fn silence_is_an_error_naming_the_recording() {
+    let silent = Recording::new("edge", vec![0.0; 48_000], RATE);
+    let error = fit_bank(&[silent], &FitOptions::default()).unwrap_err();
+    assert!(matches!(error, FitError::Silent { .. }), "{error:?}");
+    let message = error.to_string();
+    assert!(
+        message.contains("edge") && message.contains("no strike"),
+        "{message}"
+    );
+
+    // Steady noise has no strike either.
+    let noise: Vec<f32> = gaussian_noise(48_000, 3)
+        .iter()
+        .map(|v| 0.01 * *v as f32)
+        .collect();
+    let error = fit_bank(
+        &[Recording::new("edge", noise, RATE)],
+        &FitOptions::default(),
+    )
+    .unwrap_err();
+    assert!(matches!(error, FitError::Silent { .. }), "{error:?}");
+}
+
+#[test]
+fn a_recording_too_short_to_measure_is_an_error() {
+    let bank = truth_bank();
+    let mut recording = noisy_recording(&bank, 0, SNR_DB, 5);
+    // The lead-in and 20 ms of the strike.
+    recording
+        .samples
+        .truncate(((LEAD_IN_S + 0.02) * RATE as f64) as usize);
+    let error = fit_bank(&[recording], &FitOptions::default()).unwrap_err();
+    match &error {
+        FitError::TooShort {
+            found_s, needed_s, ..
+        } => assert!(found_s < needed_s, "{error}"),
+        other => panic!("expected TooShort, got {other:?}"),
+    }
+    assert!(error.to_string().contains("after the strike"), "{error}");
+}
+
+#[test]
+fn clipped_and_very_noisy_recordings_fit_with_warnings() {
+    let bank = truth_bank();
+    // Driven four times too hot into a converter that clips at full scale.
+    let mut clipped = noisy_recording(&bank, 0, SNR_DB, 7);
+    for v in &mut clipped.samples {
+        *v = (*v * 4.0 / STRONGEST as f32).clamp(-1.0, 1.0);
+    }
+    let fit = fit_bank(&[clipped], &FitOptions::default()).unwrap();
+    let warnings = &fit.report.recordings[0].warnings;
+    assert!(
+        warnings.iter().any(|w| w.starts_with("clipped")),
+        "{warnings:?}"
+    );
+    assert!(fit.report.to_string().contains("warning: clipped"));
+
+    // Noise 12 dB below the render's RMS: the strike's first millisecond stands about 26 dB
+    // above it.
+    let noisy = noisy_recording(&bank, 1, 12.0, 8);
+    let fit = fit_bank(&[noisy], &FitOptions::default()).unwrap();
+    let warnings = &fit.report.recordings[0].warnings;
+    assert!(
+        warnings.iter().any(|w| w.starts_with("very noisy")),
+        "{warnings:?}"
+    );
+    // The strongest modes are still found.
+    for f in [196.0, 523.7] {
+        assert!(
+            fit.bank
+                .modes
+                .iter()
+                .any(|m| (m.freq_hz / f - 1.0).abs() < FREQ_TOLERANCE),
+            "{f} Hz not found in the noisy recording"
+        );
+    }
+}
+
+#[test]
+fn bad_names_and_options_are_errors() {
+    let bank = truth_bank();
+    let a = noisy_recording(&bank, 0, SNR_DB, 9);
+    let error = fit_bank(&[a.clone(), a.clone()], &FitOptions::default()).unwrap_err();
+    assert!(matches!(error, FitError::DuplicateName { .. }), "{error:?}");
+    assert!(matches!(
+        fit_bank(&[], &FitOptions::default()).unwrap_err(),
+        FitError::NoRecordings
+    ));
+    for options in [
+        FitOptions {
+            max_modes: 0,
+            ..FitOptions::default()
+        },
+        FitOptions {
+            min_hz: 5_000.0,
+            max_hz: 1_000.0,
+            ..FitOptions::default()
+        },
+        FitOptions {
+            noise_floor_db: Some(3.0),
+            ..FitOptions::default()
+        },
+    ] {
+        let error = fit_bank(std::slice::from_ref(&a), &options).unwrap_err();
+        assert!(matches!(error, FitError::BadOption { .. }), "{error:?}");
+    }
+    let low = Recording::new("edge", a.samples.clone(), 4_000);
+    let error = fit_bank(&[low], &FitOptions::default()).unwrap_err();
+    assert!(error.to_string().contains("8000 Hz"), "{error}");
+}
+
+#[test]
+fn the_mode_count_and_frequency_range_are_respected() {
+    let bank = truth_bank();
+    let recordings: Vec<Recording> = (0..2)
+        .map(|k| noisy_recording(&bank, k, SNR_DB, 30 + k as u64))
+        .collect();
+    let options = FitOptions {
+        max_modes: 4,
+        min_hz: 300.0,
+        max_hz: 6_000.0,
+        ..FitOptions::default()
+    };
+    let fit = fit_bank(&recordings, &options).unwrap();
+    assert_eq!(fit.bank.modes.len(), 4);
+    assert!(fit
+        .bank
+        .modes
+        .iter()
+        .all(|m| (300.0..=6_000.0).contains(&m.freq_hz)));
+    // The four with the most energy in range (seed 000 eq. 5.15, about a^2 / d here).
+    for (m, expected) in fit.bank.modes.iter().zip([523.7, 1000.0, 1012.0, 1571.3]) {
+        assert!(
+            (m.freq_hz / expected - 1.0).abs() < FREQ_TOLERANCE,
+            "kept {} Hz, expected {expected} Hz",
+            m.freq_hz
+        );
+    }
+
+    // A noise floor above the weak modes leaves them out.
+    let options = FitOptions {
+        noise_floor_db: Some(20.0 * (STRONGEST * 10f64.powf(-20.0 / 20.0)).log10()),
+        ..FitOptions::default()
+    };
+    let fit = fit_bank(&recordings, &options).unwrap();
+    let largest = fit
+        .bank
+        .modes
+        .iter()
+        .flat_map(|m| m.gains.iter())
+        .fold(0.0f64, |a, g| a.max(g.abs()));
+    for m in &fit.bank.modes {
+        let strongest_db = db(m.gains.iter().fold(0.0f64, |a, g| a.max(g.abs())) / largest);
+        assert!(
+            strongest_db > -21.0,
+            "{} Hz at {strongest_db:.1} dB kept",
+            m.freq_hz
+        );
+    }
+}
