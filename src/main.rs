@@ -13,7 +13,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use modal_resonator::engine::{Controls, PreparedBank};
 use modal_resonator::model::factory::{factory_bank, factory_banks, factory_slug};
-use modal_resonator::model::fit::{fit_bank, read_wav_recording, FitOptions, FitReport};
+use modal_resonator::model::fit::{fit_bank, read_wav_recording, save_report_file, FitOptions};
 use modal_resonator::model::schema::bank_schema_json;
 use modal_resonator::model::summary::BankSummary;
 use modal_resonator::model::{load_bank_file, save_bank_file, Bank};
@@ -351,7 +351,8 @@ fn run_fit(args: &FitArgs) -> Result<(), String> {
     fit.bank.license = args.license.clone();
     save_bank_file(&fit.bank, &args.output).map_err(|e| e.to_string())?;
     if let Some(path) = &args.report {
-        write_report(path, &fit.report)?;
+        save_report_file(&fit.report, path)
+            .map_err(|e| format!("{}: cannot write the report: {e}", path.display()))?;
     }
     print!("{}", fit.report);
     for r in &fit.report.recordings {
@@ -381,32 +382,6 @@ fn split_recording_arg(arg: &str) -> (PathBuf, String) {
         .file_stem()
         .map_or_else(|| arg.to_string(), |s| s.to_string_lossy().into_owned());
     (whole, position)
-}
-
-/// Writes the fit report to `path` atomically: JSON when the name ends in `.json`, else text.
-fn write_report(path: &Path, report: &FitReport) -> Result<(), String> {
-    let text = if path.extension().is_some_and(|e| e == "json") {
-        let mut json = serde_json::to_string_pretty(report)
-            .map_err(|e| format!("{}: cannot write the report: {e}", path.display()))?;
-        json.push('\n');
-        json
-    } else {
-        report.to_string()
-    };
-    let dir = match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir,
-        _ => Path::new("."),
-    };
-    let fail = |e: std::io::Error| format!("{}: cannot write the report: {e}", path.display());
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".modal-report-").suffix(".tmp");
-    // A file the user asked for: the usual permissions less the umask, not a private temporary.
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let mut file = builder.tempfile_in(dir).map_err(fail)?;
-    std::io::Write::write_all(&mut file, text.as_bytes()).map_err(fail)?;
-    file.persist(path).map_err(|e| fail(e.error))?;
-    Ok(())
 }
 
 /// Fails early, before a long render, when the output is a directory or its directory does not

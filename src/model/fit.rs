@@ -26,6 +26,7 @@ mod peaks;
 mod report;
 mod stft;
 mod track;
+mod warnings;
 mod wav;
 
 use std::collections::HashSet;
@@ -34,7 +35,7 @@ use serde_json::{json, Map};
 
 pub use error::FitError;
 pub use fidelity::{resynthesize, Fidelity};
-pub use report::{FitReport, ModeReport, RecordingReport};
+pub use report::{save_report_file, FitReport, ModeReport, RecordingReport};
 pub use wav::read_wav_recording;
 
 use self::analyse::{analyse, prepare, Analysis};

@@ -15,6 +15,7 @@ use super::onset::{find_strike, Strike};
 use super::peaks::vote;
 use super::stft::{hann, Spectrogram};
 use super::track::{track, Track};
+use super::warnings::input_warnings;
 use super::{FitError, FitOptions, Recording};
 use crate::model::limen::difference_limen_hz;
 
@@ -39,18 +40,9 @@ const ROUNDS: usize = 3;
 /// Zero-padding of the voting spectrogram.
 const PAD: usize = 2;
 
-/// A sample at or above this magnitude counts as full scale...
-const CLIP_LEVEL: f32 = 0.999;
-
-/// ... and this many in a row as clipping.
-const CLIP_RUN: usize = 3;
-
 /// A mode whose amplitude falls by less than this many nepers (10%) over the recording is a
 /// steady tone, not part of the ring.
 const STEADY_NEPERS: f64 = 0.1;
-
-/// A strike less than this many dB above the noise gets a warning.
-pub const NOISY_SNR_DB: f64 = 30.0;
 
 /// One mode found in a recording.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -181,21 +173,7 @@ pub fn prepare(recording: &Recording, options: &FitOptions) -> Result<Analysis, 
     let window_sums = (window.iter().sum(), window.iter().map(|w| w * w).sum());
     let hop = window_len / 4;
 
-    let mut warnings = recording.notes.clone();
-    let clipped = clipped_samples(&recording.samples);
-    if clipped > 0 {
-        warnings.push(format!(
-            "clipped: {clipped} samples at full scale in runs of {CLIP_RUN} or more; the strongest \
-             modes' gains and decays are unreliable: record with more headroom"
-        ));
-    }
-    if strike.snr_db < NOISY_SNR_DB {
-        warnings.push(format!(
-            "very noisy: the strike stands only {:.1} dB above the noise ({NOISY_SNR_DB} dB or \
-             more is advised); weak modes are lost and decays are less certain",
-            strike.snr_db
-        ));
-    }
+    let warnings = input_warnings(recording, &strike);
 
     let whole = Spectrogram::new(&x, rate, window_len, hop, PAD);
     let noise = NoiseSpectrum::estimate(&whole, window_sums.0);
@@ -386,21 +364,4 @@ pub fn shapes_of(modes: &[Found]) -> Vec<Shape> {
             decay_per_s: m.decay_per_s,
         })
         .collect()
-}
-
-/// Samples in runs of at least [`CLIP_RUN`] at full scale.
-fn clipped_samples(samples: &[f32]) -> usize {
-    let mut total = 0;
-    let mut run = 0;
-    for &v in samples.iter().chain(std::iter::once(&0.0)) {
-        if v.abs() >= CLIP_LEVEL {
-            run += 1;
-        } else {
-            if run >= CLIP_RUN {
-                total += run;
-            }
-            run = 0;
-        }
-    }
-    total
 }

@@ -2,6 +2,8 @@
 //! bank comes to it, and every warning.
 
 use std::fmt;
+use std::io::Write;
+use std::path::Path;
 
 use serde::Serialize;
 
@@ -159,4 +161,32 @@ impl fmt::Display for FitReport {
         }
         Ok(())
     }
+}
+
+/// Writes `report` to `path`: JSON when the name ends in `.json`, else the text the command line
+/// prints. Atomic like saving a bank: a temporary file in the same directory renamed over `path`,
+/// so a failure leaves `path` as it was.
+pub fn save_report_file(report: &FitReport, path: &Path) -> std::io::Result<()> {
+    let text = if path.extension().is_some_and(|e| e == "json") {
+        // Serializing plain numbers and strings cannot fail; an infinite T60 becomes null.
+        let mut json = serde_json::to_string_pretty(report).expect("a report serializes");
+        json.push('\n');
+        json
+    } else {
+        report.to_string()
+    };
+    let dir = match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    };
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".modal-report-").suffix(".tmp");
+    // A file the user asked for: the usual permissions less the umask, not a private temporary.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let mut file = builder.tempfile_in(dir)?;
+    file.write_all(text.as_bytes())?;
+    file.as_file().sync_all()?;
+    file.persist(path).map_err(|e| e.error)?;
+    Ok(())
 }
