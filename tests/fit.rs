@@ -488,3 +488,50 @@ fn the_mode_count_and_frequency_range_are_respected() {
         );
     }
 }
+
+#[test]
+fn modes_closer_than_the_difference_limen_come_out_as_one() {
+    // 1 Hz apart at 1 kHz, where the limen is 2.5 Hz (seed 000 section 5.4.1): one mode.
+    let mut bank = Bank::new(
+        "pair",
+        vec![
+            Position {
+                name: "a".into(),
+                coords: vec![0.0],
+            },
+            Position {
+                name: "b".into(),
+                coords: vec![1.0],
+            },
+        ],
+    );
+    for (freq_hz, decay_per_s, gains) in [
+        (440.0, 2.0, vec![0.3, 0.2]),
+        (1000.0, 3.0, vec![0.1, 0.05]),
+        (1001.0, 3.0, vec![0.1, 0.05]),
+    ] {
+        bank.modes.push(Mode {
+            freq_hz,
+            decay_per_s,
+            gains,
+        });
+    }
+    let recordings: Vec<Recording> = (0..2)
+        .map(|k| noisy_recording(&bank, k, SNR_DB, 50 + k as u64))
+        .collect();
+    let fit = fit_bank(&recordings, &FitOptions::default()).unwrap();
+    let near: Vec<f64> = fit
+        .bank
+        .modes
+        .iter()
+        .map(|m| m.freq_hz)
+        .filter(|f| (f - 1000.5).abs() < 10.0)
+        .collect();
+    assert_eq!(near.len(), 1, "modes near 1 kHz: {near:?}");
+    assert!(
+        (near[0] - 1000.5).abs() < 1.0,
+        "merged mode at {} Hz",
+        near[0]
+    );
+    assert_eq!(fit.bank.modes.len(), 2, "{:?}", fit.bank.modes);
+}
