@@ -552,3 +552,155 @@ fn factory_presets_render_and_describe_by_name() {
     let parsed: serde_json::Value = serde_json::from_slice(&schema.stdout).unwrap();
     assert!(parsed.get("properties").is_some());
 }
+
+/// Writes a WAV file of `channels` channels at 48 kHz: a lead-in, then a strike of two modes
+/// (440 Hz and 1234.5 Hz) in every channel, over faint deterministic noise.
+fn write_strike_wav(path: &Path, channels: u16) {
+    let spec = hound::WavSpec {
+        channels,
+        sample_rate: 48_000,
+        bits_per_sample: 16,
+        sample_format: hound::SampleFormat::Int,
+    };
+    let mut writer = hound::WavWriter::create(path, spec).unwrap();
+    let mut seed = 1u32;
+    for n in 0..(1.5 * 48_000.0) as usize {
+        let t = n as f64 / 48_000.0 - 0.05;
+        let tau = std::f64::consts::TAU;
+        let ring = if t >= 0.0 {
+            0.5 * (-3.0 * t).exp() * (tau * 440.0 * t).sin()
+                + 0.2 * (-9.0 * t).exp() * (tau * 1234.5 * t).sin()
+        } else {
+            0.0
+        };
+        for _ in 0..channels {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            let noise = 1e-4 * (seed as f64 / u32::MAX as f64 - 0.5);
+            writer
+                .write_sample(((ring + noise) * 32767.0).round() as i16)
+                .unwrap();
+        }
+    }
+    writer.finalize().unwrap();
+}
+
+#[test]
+fn fit_writes_a_bank_and_a_report_from_recordings() {
+    let dir = dir_with_bank();
+    write_strike_wav(&dir.path().join("edge.wav"), 1);
+    write_strike_wav(&dir.path().join("middle.wav"), 2);
+    let out = run(
+        dir.path(),
+        &[
+            "fit",
+            "edge.wav",
+            "middle.wav=centre",
+            "-o",
+            "fitted.json",
+            "--modes",
+            "8",
+            "--report",
+            "report.json",
+            "--license",
+            "CC0-1.0",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert!(text.contains("log-spectral distance"), "{text}");
+    assert!(text.contains("fitted.json: 2 modes, 2 positions"), "{text}");
+    // The stereo file was mixed to mono, and says so.
+    assert!(stderr(&out).contains("centre: stereo"), "{}", stderr(&out));
+
+    let bank = modal_resonator::model::load_bank_file(&dir.path().join("fitted.json")).unwrap();
+    assert_eq!(bank.name, "fitted");
+    assert_eq!(bank.license, "CC0-1.0");
+    let names: Vec<&str> = bank.positions.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names, ["edge", "centre"]);
+    for (m, f) in bank.modes.iter().zip([440.0, 1234.5]) {
+        assert!(
+            (m.freq_hz / f - 1.0).abs() < 1e-4,
+            "{} Hz vs {f} Hz",
+            m.freq_hz
+        );
+    }
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("report.json")).unwrap())
+            .unwrap();
+    assert_eq!(report["recordings"][1]["name"], "centre");
+    assert!(
+        report["recordings"][0]["lsd_db"].as_f64().unwrap() < 3.0,
+        "{report}"
+    );
+    assert_eq!(report["modes"].as_array().unwrap().len(), 2);
+}
+
+#[test]
+fn fit_rejects_bad_recordings_and_writes_nothing() {
+    let dir = dir_with_bank();
+    std::fs::write(dir.path().join("notes.wav"), "these are words, not sound").unwrap();
+    let out = run(dir.path(), &["fit", "notes.wav", "-o", "out.json"]);
+    assert_failed_cleanly(
+        &out,
+        &["notes.wav", "not a WAV file"],
+        dir.path(),
+        &["notes.wav"],
+    );
+
+    write_strike_wav(&dir.path().join("surround.wav"), 3);
+    let out = run(dir.path(), &["fit", "surround.wav", "-o", "out.json"]);
+    assert_failed_cleanly(
+        &out,
+        &["surround.wav", "3 channels", "mono or stereo"],
+        dir.path(),
+        &["notes.wav", "surround.wav"],
+    );
+
+    let out = run(dir.path(), &["fit", "missing.wav", "-o", "out.json"]);
+    assert_failed_cleanly(
+        &out,
+        &["missing.wav", "cannot read"],
+        dir.path(),
+        &["notes.wav", "surround.wav"],
+    );
+
+    // Silence: a valid WAV file with nothing in it.
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: 44_100,
+        bits_per_sample: 16,
+        sample_format: hound::SampleFormat::Int,
+    };
+    let mut writer = hound::WavWriter::create(dir.path().join("silence.wav"), spec).unwrap();
+    for _ in 0..44_100 {
+        writer.write_sample(0i16).unwrap();
+    }
+    writer.finalize().unwrap();
+    let out = run(dir.path(), &["fit", "silence.wav=top", "-o", "out.json"]);
+    assert_failed_cleanly(
+        &out,
+        &["top", "no strike found", "every sample is zero"],
+        dir.path(),
+        &["notes.wav", "silence.wav", "surround.wav"],
+    );
+
+    let out = run(
+        dir.path(),
+        &[
+            "fit",
+            "silence.wav",
+            "-o",
+            "out.json",
+            "--noise-floor-db",
+            "6",
+        ],
+    );
+    assert_failed_cleanly(
+        &out,
+        &["--noise-floor-db 6"],
+        dir.path(),
+        &["notes.wav", "silence.wav", "surround.wav"],
+    );
+}

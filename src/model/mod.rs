@@ -4,7 +4,9 @@
 
 pub mod bank;
 pub mod factory;
+pub mod fit;
 pub mod io;
+pub mod limen;
 pub mod materials;
 pub mod schema;
 pub mod shapes;
