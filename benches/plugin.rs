@@ -29,13 +29,7 @@ fn engine_realtime_factor(bank: &Bank, seconds: f64) -> f64 {
     let mut controls = ModalParams::new(false).controls(0.0, 0.0, 0.0);
     controls.truncation_db = -140.0;
     engine.set_controls(&controls);
-    let notes: Vec<NoteEvent> = KEYS
-        .map(|key| NoteEvent::On {
-            time: 0,
-            key,
-            velocity: 1.0,
-        })
-        .collect();
+    let notes: Vec<NoteEvent> = KEYS.map(|key| NoteEvent::on(0, key, 1.0)).collect();
     let (mut l, mut r) = (vec![0.0f32; BLOCK], vec![0.0f32; BLOCK]);
     engine.process(&notes, None, &mut l, &mut r);
     let blocks = (seconds * RATE_HZ as f64) as usize / BLOCK;

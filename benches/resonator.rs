@@ -74,13 +74,7 @@ fn engine_realtime_factor(kernel: Kernel, sweep: bool, seconds: f64) -> (f64, us
         controls.truncation_db = -140.0;
         engine.set_controls(&controls);
         // Keys 24..40 keep every mode below 0.45 fs.
-        let notes: Vec<NoteEvent> = (0..16)
-            .map(|i| NoteEvent::On {
-                time: 0,
-                key: 24 + i,
-                velocity: 1.0,
-            })
-            .collect();
+        let notes: Vec<NoteEvent> = (0..16).map(|i| NoteEvent::on(0, 24 + i, 1.0)).collect();
         let (mut l, mut r) = (vec![0.0f32; BLOCK], vec![0.0f32; BLOCK]);
         engine.process(&notes, None, &mut l, &mut r);
         let blocks = (seconds * RATE_HZ) as usize / BLOCK;

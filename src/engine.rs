@@ -27,7 +27,7 @@ pub use controls::{
 pub use position::{PositionMap, PositionWeights};
 pub use prepared::{PreparedBank, TARGET_PEAK};
 use stereo::lane_weights;
-use voice::{Tuning, Voice, VoiceState};
+use voice::{PendingStrike, Tuning, Voice, VoiceOverrides, VoiceState};
 
 use crate::dsp::coeffs::{db_to_gain, t60_to_decay, MIN_DECAY_PER_S};
 use crate::dsp::denormal::FlushDenormals;
@@ -58,27 +58,81 @@ const DAMPING_SMOOTHING_S: f64 = 0.02;
 /// Time constant of output gain smoothing, in seconds.
 const GAIN_SMOOTHING_S: f64 = 0.01;
 
+/// Most ended voices kept between two calls to [`Engine::take_ended_voices`]; more are not
+/// reported.
+const MAX_ENDED: usize = 4 * (MAX_POLYPHONY + FADE_SLOTS);
+
+/// Time constant of input gain smoothing, in seconds.
+const INPUT_GAIN_SMOOTHING_S: f64 = 0.01;
+
 /// Seed of the engine's random numbers (strike variation, noise), restored by `reset`.
 const SEED: u32 = 0x5EED_0001;
+
+/// Which note an event is about: a key on a MIDI channel, and the host's id for the note when it
+/// gives one (CLAP note ids).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Note {
+    /// MIDI key, 0 to 127 (larger values match no voice by key).
+    pub key: u8,
+    /// MIDI channel, 0 to 15: notes on different channels are different voices (MPE).
+    pub channel: u8,
+    /// The host's id for the note, if any.
+    pub id: Option<i32>,
+}
+
+impl Note {
+    /// `key` on the first channel, without an id.
+    pub const fn key(key: u8) -> Self {
+        Self {
+            key,
+            channel: 0,
+            id: None,
+        }
+    }
+
+    /// Whether this note names voice `v`: by id when both have one, else by key and channel.
+    fn names(&self, v: &Voice) -> bool {
+        match (self.id, v.id) {
+            (Some(a), Some(b)) if a == b => true,
+            _ => v.key == self.key && v.channel == self.channel,
+        }
+    }
+}
 
 /// A note event at a sample offset within the block passed to [`Engine::process`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum NoteEvent {
-    /// Strike `key` with `velocity` (0 to 1; 0 acts as a note-off).
-    On { time: u32, key: u8, velocity: f32 },
-    /// Release `key`.
-    Off { time: u32, key: u8 },
-    /// Release every key (MIDI CC 123).
+    /// Strike `note` with `velocity` (0 to 1; 0 acts as a note-off).
+    On {
+        time: u32,
+        note: Note,
+        velocity: f32,
+    },
+    /// Release `note`.
+    Off { time: u32, note: Note },
+    /// Release every note (MIDI CC 123).
     AllNotesOff { time: u32 },
     /// Silence every voice at once (MIDI CC 120).
     AllSoundOff { time: u32 },
-    /// Silence the voices on `key` at once (a hi-hat choke; CLAP choke events).
-    Choke { time: u32, key: u8 },
-    /// Change the sounding note on `key` alone (CLAP note expressions, MPE).
+    /// Silence the voice of `note` at once (a hi-hat choke; CLAP choke events).
+    Choke { time: u32, note: Note },
+    /// Change the sounding `note` alone (CLAP note expressions).
     Expression {
         time: u32,
-        key: u8,
+        note: Note,
         expression: NoteExpression,
+    },
+    /// Change every note sounding on `channel` (MPE: a member channel's bend and pressure).
+    ChannelExpression {
+        time: u32,
+        channel: u8,
+        expression: NoteExpression,
+    },
+    /// Set a control of the voice the host knows as `id` alone (CLAP polyphonic modulation).
+    Modulate {
+        time: u32,
+        id: i32,
+        modulation: VoiceModulation,
     },
 }
 
@@ -91,7 +145,73 @@ pub enum NoteExpression {
     Pressure(f32),
 }
 
+/// A control one voice holds in place of the engine's, in the same units as [`Controls`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum VoiceModulation {
+    /// Fine tune in cents.
+    FineTuneCents(f32),
+    /// Size ratio (pitch falls as size grows).
+    SizeRatio(f32),
+    /// Strike position along the first axis, 0 to 1.
+    StrikeX(f32),
+    /// Strike position along the second axis, 0 to 1.
+    StrikeY(f32),
+    /// Mallet contact time in milliseconds.
+    HardnessMs(f32),
+}
+
+impl VoiceModulation {
+    /// The modulation clamped to its control's range, or `None` when its value is NaN.
+    fn sanitized(self) -> Option<Self> {
+        let (name, value) = match self {
+            VoiceModulation::FineTuneCents(v) => ("fine_tune_cents", v),
+            VoiceModulation::SizeRatio(v) => ("size_ratio", v),
+            VoiceModulation::StrikeX(v) => ("strike_x", v),
+            VoiceModulation::StrikeY(v) => ("strike_y", v),
+            VoiceModulation::HardnessMs(v) => ("hardness_ms", v),
+        };
+        if value.is_nan() {
+            return None;
+        }
+        let spec = NUMERIC_CONTROLS.iter().find(|s| s.name == name)?;
+        let v = value.clamp(spec.min, spec.max);
+        Some(match self {
+            VoiceModulation::FineTuneCents(_) => VoiceModulation::FineTuneCents(v),
+            VoiceModulation::SizeRatio(_) => VoiceModulation::SizeRatio(v),
+            VoiceModulation::StrikeX(_) => VoiceModulation::StrikeX(v),
+            VoiceModulation::StrikeY(_) => VoiceModulation::StrikeY(v),
+            VoiceModulation::HardnessMs(_) => VoiceModulation::HardnessMs(v),
+        })
+    }
+}
+
+/// A voice that stopped sounding, so a host can release what it keeps for the note.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EndedVoice {
+    /// Sample offset within the block of the `process` call in which it ended.
+    pub time: u32,
+    /// The note it played.
+    pub note: Note,
+}
+
 impl NoteEvent {
+    /// Strike `key` on the first channel.
+    pub const fn on(time: u32, key: u8, velocity: f32) -> Self {
+        NoteEvent::On {
+            time,
+            note: Note::key(key),
+            velocity,
+        }
+    }
+
+    /// Release `key` on the first channel.
+    pub const fn off(time: u32, key: u8) -> Self {
+        NoteEvent::Off {
+            time,
+            note: Note::key(key),
+        }
+    }
+
     /// Sample offset of the event within its block.
     pub fn time(&self) -> u32 {
         match *self {
@@ -100,30 +220,25 @@ impl NoteEvent {
             | NoteEvent::AllNotesOff { time }
             | NoteEvent::AllSoundOff { time }
             | NoteEvent::Choke { time, .. }
-            | NoteEvent::Expression { time, .. } => time,
+            | NoteEvent::Expression { time, .. }
+            | NoteEvent::ChannelExpression { time, .. }
+            | NoteEvent::Modulate { time, .. } => time,
         }
     }
 
     /// The same event at sample `time`.
-    pub fn at(self, time: u32) -> Self {
-        match self {
-            NoteEvent::On { key, velocity, .. } => NoteEvent::On {
-                time,
-                key,
-                velocity,
-            },
-            NoteEvent::Off { key, .. } => NoteEvent::Off { time, key },
-            NoteEvent::AllNotesOff { .. } => NoteEvent::AllNotesOff { time },
-            NoteEvent::AllSoundOff { .. } => NoteEvent::AllSoundOff { time },
-            NoteEvent::Choke { key, .. } => NoteEvent::Choke { time, key },
-            NoteEvent::Expression {
-                key, expression, ..
-            } => NoteEvent::Expression {
-                time,
-                key,
-                expression,
-            },
+    pub fn at(mut self, at: u32) -> Self {
+        match &mut self {
+            NoteEvent::On { time, .. }
+            | NoteEvent::Off { time, .. }
+            | NoteEvent::AllNotesOff { time }
+            | NoteEvent::AllSoundOff { time }
+            | NoteEvent::Choke { time, .. }
+            | NoteEvent::Expression { time, .. }
+            | NoteEvent::ChannelExpression { time, .. }
+            | NoteEvent::Modulate { time, .. } => *time = at,
         }
+        self
     }
 }
 
@@ -158,6 +273,8 @@ struct Smoothed {
     tilt: f64,
     /// Output gain, linear, smoothed per sample.
     gain: f32,
+    /// Input gain, linear, smoothed per sample.
+    input_gain: f32,
     /// Left and right column weights now.
     weights: ([f32; COLUMNS], [f32; COLUMNS]),
     /// Per-sample change of the weights while ramping.
@@ -210,6 +327,10 @@ pub struct Engine {
     fade_acc: Vec<[f32; COLUMNS]>,
     /// Excitation of one voice for the current run.
     excitation: Vec<f32>,
+    /// Voices that stopped sounding since the host last asked.
+    ended: Vec<EndedVoice>,
+    /// Sample offset within the current `process` call.
+    block_pos: u32,
 }
 
 impl Engine {
@@ -221,6 +342,7 @@ impl Engine {
             log_damping: 0.0,
             tilt: 0.0,
             gain: 1.0,
+            input_gain: 1.0,
             weights: lane_weights(controls.width),
             weight_target: lane_weights(controls.width),
             weight_step: ([0.0; COLUMNS], [0.0; COLUMNS]),
@@ -247,6 +369,8 @@ impl Engine {
             acc: Vec::new(),
             fade_acc: Vec::new(),
             excitation: Vec::new(),
+            ended: Vec::new(),
+            block_pos: 0,
         }
     }
 
@@ -261,6 +385,7 @@ impl Engine {
         self.acc = vec![[0.0; COLUMNS]; CONTROL_PERIOD];
         self.fade_acc = vec![[0.0; COLUMNS]; CONTROL_PERIOD];
         self.excitation = vec![0.0; CONTROL_PERIOD];
+        self.ended = Vec::with_capacity(MAX_ENDED);
         self.allocate_voices();
         self.reset();
     }
@@ -276,9 +401,7 @@ impl Engine {
         if !self.voices.is_empty() && !fits {
             self.allocate_voices();
         } else {
-            for v in self.voices.iter_mut().chain(self.input_voice.as_mut()) {
-                v.free();
-            }
+            self.end_all_voices();
         }
         self.decay.resize(self.bank.num_modes(), 0.0);
         self.tilted_decay.resize(self.bank.num_modes(), 0.0);
@@ -308,11 +431,14 @@ impl Engine {
         self.input_heard = false;
         self.input_dormant = true;
         self.rng = Rng::new(SEED);
+        // A reset ends every note for the host too: nothing left to report.
+        self.ended.clear();
         let (log_damping, tilt) = self.damping_targets();
         self.smoothed = Smoothed {
             log_damping,
             tilt,
             gain: db_to_gain(self.controls.output_gain_db),
+            input_gain: db_to_gain(self.controls.input_gain_db),
             weights: lane_weights(self.controls.width),
             weight_target: lane_weights(self.controls.width),
             weight_step: ([0.0; COLUMNS], [0.0; COLUMNS]),
@@ -370,6 +496,23 @@ impl Engine {
         s
     }
 
+    /// Silences every voice at once, reporting each as ended. Does not allocate.
+    pub fn end_all_voices(&mut self) {
+        for v in self.voices.iter_mut() {
+            end_voice(v, &mut self.ended, self.block_pos);
+        }
+        if let Some(v) = self.input_voice.as_mut() {
+            v.free();
+        }
+    }
+
+    /// Hands over the voices that stopped sounding during the last `process` calls (freed,
+    /// choked, faded out after stealing, or taken over by a new note with another id), each
+    /// with its sample offset in the call where it ended. Does not allocate.
+    pub fn take_ended_voices(&mut self) -> impl Iterator<Item = EndedVoice> + '_ {
+        self.ended.drain(..)
+    }
+
     /// The keys of the voices sounding now (held or ringing after release), in voice order.
     pub fn sounding_keys(&self) -> impl Iterator<Item = u8> + '_ {
         self.voices
@@ -385,6 +528,21 @@ impl Engine {
             .chain(self.input_voice.as_ref())
             .all(|v| v.state == VoiceState::Free && v.modes.num_live() == 0)
     }
+}
+
+/// Frees `v`, recording it in `ended` (while there is room) when it was playing a note.
+fn end_voice(v: &mut Voice, ended: &mut Vec<EndedVoice>, time: u32) {
+    if v.state != VoiceState::Free && ended.len() < ended.capacity() {
+        ended.push(EndedVoice {
+            time,
+            note: Note {
+                key: v.key,
+                channel: v.channel,
+                id: v.id,
+            },
+        });
+    }
+    v.free();
 }
 
 mod process;

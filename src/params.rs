@@ -8,7 +8,29 @@ use nice_plug::params::persist::PersistentField;
 use nice_plug::prelude::*;
 
 use crate::dsp::ExciterKind;
-use crate::engine::{Controls, Material, MATERIAL_Q_RANGE, MAX_POLYPHONY};
+use crate::engine::{Controls, Material, VoiceModulation, MATERIAL_Q_RANGE, MAX_POLYPHONY};
+use crate::model::factory::factory_bank;
+use crate::plugin::DEFAULT_FACTORY_BANK;
+
+/// Polyphonic modulation ids (CLAP): a host can offset these parameters for one note alone.
+pub mod poly_id {
+    /// Fine tune.
+    pub const FINE_TUNE: u32 = 0;
+    /// Size.
+    pub const SIZE: u32 = 1;
+    /// Strike position X.
+    pub const STRIKE_X: u32 = 2;
+    /// Strike position Y.
+    pub const STRIKE_Y: u32 = 3;
+    /// Hardness.
+    pub const HARDNESS: u32 = 4;
+    /// How many there are.
+    pub const COUNT: usize = 5;
+}
+
+/// Default per-note pitch-bend range of MPE member channels, in semitones (the MPE
+/// specification's default).
+pub const MPE_DEFAULT_BEND_RANGE: f32 = 48.0;
 
 /// Version of the plugin state's own fields; raised when they change meaning.
 pub const STATE_FORMAT: u32 = 1;
@@ -168,6 +190,12 @@ pub struct ModalParams {
     pub mod_wheel_target: EnumParam<ExpressionTarget>,
     #[id = "press"]
     pub pressure_target: EnumParam<ExpressionTarget>,
+    /// MIDI Polyphonic Expression: each note on its own channel (2 to 16), whose pitch bend and
+    /// pressure shape that note alone; channel 1 stays global.
+    #[id = "mpe"]
+    pub mpe: BoolParam,
+    #[id = "mpebnd"]
+    pub mpe_bend_range: FloatParam,
 }
 
 fn percent(name: &str, default: f32) -> FloatParam {
@@ -187,6 +215,9 @@ impl ModalParams {
     /// The parameters with their defaults; `is_effect` sets defaults that suit the effect (input
     /// driving the modes, half wet).
     pub fn new(is_effect: bool) -> Self {
+        // Defaults that suit the bank a new instance plays: its typical strike point and mallet.
+        let bank = factory_bank(DEFAULT_FACTORY_BANK).expect("the default factory bank exists");
+        let d = Controls::for_bank(&bank);
         Self {
             bank: BankField::default(),
             state_format: AtomicU32::new(STATE_FORMAT),
@@ -203,7 +234,7 @@ impl ModalParams {
             .with_step_size(1.0),
             damping_tilt: FloatParam::new(
                 "Damping tilt",
-                0.0,
+                d.damping_tilt,
                 FloatRange::Linear {
                     min: -2.0,
                     max: 2.0,
@@ -222,8 +253,9 @@ impl ModalParams {
             )
             .with_unit(" x")
             .with_step_size(0.001)
-            .with_smoother(SmoothingStyle::None),
-            key_tracking: percent("Key tracking", 1.0),
+            .with_smoother(SmoothingStyle::None)
+            .with_poly_modulation_id(poly_id::SIZE),
+            key_tracking: percent("Key tracking", d.key_tracking),
             fine_tune: FloatParam::new(
                 "Fine tune",
                 0.0,
@@ -233,7 +265,8 @@ impl ModalParams {
                 },
             )
             .with_unit(" ct")
-            .with_step_size(0.1),
+            .with_step_size(0.1)
+            .with_poly_modulation_id(poly_id::FINE_TUNE),
             bend_range: FloatParam::new(
                 "Pitch bend range",
                 2.0,
@@ -244,13 +277,15 @@ impl ModalParams {
             )
             .with_unit(" st")
             .with_step_size(1.0),
-            strike_x: percent("Strike position", 0.5),
-            strike_y: percent("Strike position Y", 0.5),
+            strike_x: percent("Strike position", d.strike_x)
+                .with_poly_modulation_id(poly_id::STRIKE_X),
+            strike_y: percent("Strike position Y", d.strike_y)
+                .with_poly_modulation_id(poly_id::STRIKE_Y),
             position_variation: percent("Position variation", 0.0),
             exciter: EnumParam::new("Exciter", ExciterChoice::Mallet),
             hardness: FloatParam::new(
                 "Hardness",
-                0.5,
+                d.hardness_ms,
                 FloatRange::Skewed {
                     min: 0.05,
                     max: 20.0,
@@ -258,7 +293,8 @@ impl ModalParams {
                 },
             )
             .with_unit(" ms")
-            .with_step_size(0.01),
+            .with_step_size(0.01)
+            .with_poly_modulation_id(poly_id::HARDNESS),
             velocity_sensitivity: percent("Velocity sensitivity", 0.8),
             velocity_to_hardness: percent("Velocity to hardness", 0.5),
             release_damping: percent("Release damping", 0.0),
@@ -301,7 +337,50 @@ impl ModalParams {
             dry_wet: percent("Dry/wet", if is_effect { 0.5 } else { 1.0 }),
             mod_wheel_target: EnumParam::new("Mod wheel", ExpressionTarget::Position),
             pressure_target: EnumParam::new("Pressure", ExpressionTarget::Damping),
+            mpe: BoolParam::new("MPE", false),
+            mpe_bend_range: FloatParam::new(
+                "MPE bend range",
+                MPE_DEFAULT_BEND_RANGE,
+                FloatRange::Linear {
+                    min: 0.0,
+                    max: 96.0,
+                },
+            )
+            .with_unit(" st")
+            .with_step_size(1.0),
         }
+    }
+
+    /// The parameter with polyphonic modulation id `poly_id`.
+    fn poly_param(&self, poly_id: u32) -> Option<&FloatParam> {
+        Some(match poly_id {
+            poly_id::FINE_TUNE => &self.fine_tune,
+            poly_id::SIZE => &self.size,
+            poly_id::STRIKE_X => &self.strike_x,
+            poly_id::STRIKE_Y => &self.strike_y,
+            poly_id::HARDNESS => &self.hardness,
+            _ => return None,
+        })
+    }
+
+    /// The normalised value of the parameter with polyphonic modulation id `poly_id`, before
+    /// modulation.
+    pub fn poly_base(&self, poly_id: u32) -> Option<f32> {
+        self.poly_param(poly_id)
+            .map(|p| p.unmodulated_normalized_value())
+    }
+
+    /// What one voice holds when the parameter with polyphonic modulation id `poly_id` is at
+    /// `normalized` for it (clamped to the parameter's range).
+    pub fn voice_modulation(&self, poly_id: u32, normalized: f32) -> Option<VoiceModulation> {
+        let value = self.poly_param(poly_id)?.preview_plain(normalized);
+        Some(match poly_id {
+            poly_id::FINE_TUNE => VoiceModulation::FineTuneCents(value),
+            poly_id::SIZE => VoiceModulation::SizeRatio(value),
+            poly_id::STRIKE_X => VoiceModulation::StrikeX(value),
+            poly_id::STRIKE_Y => VoiceModulation::StrikeY(value),
+            _ => VoiceModulation::HardnessMs(value),
+        })
     }
 
     /// The engine controls for the current values, with the channel's expression: pitch bend

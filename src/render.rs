@@ -201,21 +201,14 @@ fn schedule(notes: &[Note], rate: f64) -> Vec<TimedEvent> {
         events.push(TimedEvent {
             sample: on,
             rank: 1,
-            event: NoteEvent::On {
-                time: 0,
-                key: note.key,
-                velocity: note.velocity,
-            },
+            event: NoteEvent::on(0, note.key, note.velocity),
         });
         if let Some(release_s) = note.release_s() {
             let off = to_sample(release_s).max(on);
             events.push(TimedEvent {
                 sample: off,
                 rank: if off == on { 2 } else { 0 },
-                event: NoteEvent::Off {
-                    time: 0,
-                    key: note.key,
-                },
+                event: NoteEvent::off(0, note.key),
             });
         }
     }

@@ -4,7 +4,9 @@ mod common;
 
 use common::*;
 use modal_resonator::dsp::coeffs::{db_to_gain, gain_to_db, midi_key_to_hz, t60_to_decay};
-use modal_resonator::engine::{Controls, NoteEvent, CONTROL_PERIOD, TARGET_PEAK};
+use modal_resonator::engine::{
+    Controls, Note, NoteEvent, NoteExpression, VoiceModulation, CONTROL_PERIOD, TARGET_PEAK,
+};
 
 const RATE: f32 = 48_000.0;
 
@@ -14,10 +16,7 @@ fn block_size_does_not_change_the_output() {
     let events = [
         on(5, 45, 1.0),
         on(1003, 52, 0.6),
-        NoteEvent::Off {
-            time: 3000,
-            key: 45,
-        },
+        NoteEvent::off(3000, 45),
         on(7777, 45, 0.3),
     ];
     let reference = render(&mut engine(&bank, RATE), &events, 0.5, 4096);
@@ -395,11 +394,7 @@ fn extreme_values_and_bad_input_never_break_the_sound() {
         let key = (next() * 127.0) as u8;
         let events = [
             on((next() * 255.0) as u32, key, next() * 1.5),
-            NoteEvent::On {
-                time: 255,
-                key,
-                velocity: f32::NAN,
-            },
+            NoteEvent::on(255, key, f32::NAN),
         ];
         e.process(&events, Some(&input), &mut l, &mut r);
         for (i, v) in l.iter().chain(&r).enumerate() {
@@ -670,7 +665,7 @@ fn note_expressions_change_one_note_only() {
         on(0, 64, 1.0),
         NoteEvent::Expression {
             time: 4_800,
-            key: 64,
+            note: Note::key(64),
             expression: modal_resonator::engine::NoteExpression::Tuning(2.0),
         },
     ];
@@ -680,7 +675,7 @@ fn note_expressions_change_one_note_only() {
         if let Some(x) = expression {
             ev.push(NoteEvent::Expression {
                 time: 4_800,
-                key,
+                note: Note::key(key),
                 expression: x,
             });
         }
@@ -724,7 +719,7 @@ fn a_choke_silences_its_key_at_once_and_no_other() {
         on(0, 60, 1.0),
         NoteEvent::Choke {
             time: 2_000,
-            key: 57,
+            note: Note::key(57),
         },
     ];
     let (l, _) = render(&mut engine(&bank, RATE), &events, 0.2, 256);
@@ -733,4 +728,198 @@ fn a_choke_silences_its_key_at_once_and_no_other() {
     for (i, (a, b)) in l[2_000..].iter().zip(&only_60[2_000..]).enumerate() {
         assert!((a - b).abs() < 1e-6, "sample {}: {a} vs {b}", i + 2_000);
     }
+}
+
+/// A note with a channel and an id.
+fn note(key: u8, channel: u8, id: i32) -> Note {
+    Note {
+        key,
+        channel,
+        id: Some(id),
+    }
+}
+
+#[test]
+fn ended_notes_are_reported_with_their_id_and_sample() {
+    let bank = simple_bank(&[(440.0, 3.0, 1.0)]);
+    let mut e = engine(&bank, RATE);
+    let (mut l, mut r) = (vec![0.0; 512], vec![0.0; 512]);
+    // A note restruck under a new id takes over the voice: the old id ends at the restrike.
+    e.process(
+        &[
+            NoteEvent::On {
+                time: 10,
+                note: note(69, 0, 1),
+                velocity: 1.0,
+            },
+            NoteEvent::On {
+                time: 100,
+                note: note(69, 0, 2),
+                velocity: 1.0,
+            },
+            NoteEvent::Choke {
+                time: 300,
+                note: note(69, 0, 2),
+            },
+        ],
+        None,
+        &mut l,
+        &mut r,
+    );
+    let ended: Vec<_> = e.take_ended_voices().collect();
+    let want = [(100, note(69, 0, 1)), (300, note(69, 0, 2))];
+    assert_eq!(
+        ended.iter().map(|v| (v.time, v.note)).collect::<Vec<_>>(),
+        want
+    );
+    assert!(e.take_ended_voices().next().is_none(), "reported twice");
+    // A note that rings out ends when truncation frees it.
+    e.process(&[NoteEvent::on(0, 60, 1.0)], None, &mut l, &mut r);
+    let mut samples = 512;
+    let mut ended = Vec::new();
+    while ended.is_empty() && samples < 48_000 * 20 {
+        e.process(&[], None, &mut l, &mut r);
+        ended.extend(e.take_ended_voices());
+        samples += 512;
+    }
+    assert_eq!(ended.len(), 1, "the ringing note never ended");
+    assert_eq!(ended[0].note, Note::key(60));
+    assert!(e.is_silent());
+}
+
+#[test]
+fn the_same_key_on_two_channels_plays_two_voices_that_bend_apart() {
+    let bank = sine_like_bank();
+    let events = [
+        NoteEvent::On {
+            time: 0,
+            note: Note {
+                channel: 1,
+                ..Note::key(69)
+            },
+            velocity: 1.0,
+        },
+        NoteEvent::On {
+            time: 0,
+            note: Note {
+                channel: 2,
+                ..Note::key(69)
+            },
+            velocity: 1.0,
+        },
+        NoteEvent::ChannelExpression {
+            time: 0,
+            channel: 2,
+            expression: NoteExpression::Tuning(12.0),
+        },
+    ];
+    let mut e = engine(&bank, RATE);
+    let (l, _) = render(&mut e, &events, 0.3, 256);
+    assert_eq!(e.stats().voices, 2);
+    let x = &l[480..];
+    let low = magnitude_at(x, RATE as f64, 440.0);
+    let high = magnitude_at(x, RATE as f64, 880.0);
+    assert!(
+        high > 0.5 * low && low > 0.5 * high,
+        "440 Hz: {low}, 880 Hz: {high}"
+    );
+    // Tuning sent with the note-on takes effect from its first sample: no glide from 440 Hz
+    // leaves energy between the two.
+    assert!(magnitude_at(x, RATE as f64, 660.0) < 0.01 * high);
+}
+
+/// One mode at 440 Hz, rooted at A4, ringing for seconds.
+fn sine_like_bank() -> modal_resonator::model::Bank {
+    let mut bank = simple_bank(&[(440.0, 1.0, 1.0)]);
+    bank.root_hz = Some(440.0);
+    bank
+}
+
+#[test]
+fn modulation_with_the_note_on_shapes_the_strike_and_stays_with_its_voice() {
+    let bank = sine_like_bank();
+    let on = |key: u8, id: i32| NoteEvent::On {
+        time: 0,
+        note: note(key, 0, id),
+        velocity: 1.0,
+    };
+    // Fine tune +50 cents on note 1 alone, at the note-on's sample; note 2 follows the engine.
+    let events = [
+        on(69, 1),
+        NoteEvent::Modulate {
+            time: 0,
+            id: 1,
+            modulation: VoiceModulation::FineTuneCents(50.0),
+        },
+        on(57, 2),
+        // Modulation of a note that does not exist changes nothing.
+        NoteEvent::Modulate {
+            time: 0,
+            id: 99,
+            modulation: VoiceModulation::FineTuneCents(-100.0),
+        },
+    ];
+    let (l, _) = render(&mut engine(&bank, RATE), &events, 0.3, 64);
+    let x = &l[64..];
+    let up = 440.0 * 2f64.powf(0.5 / 12.0);
+    assert!(magnitude_at(x, RATE as f64, 440.0) < 0.02 * magnitude_at(x, RATE as f64, up));
+    assert!(magnitude_at(x, RATE as f64, 220.0) > 0.5 * magnitude_at(x, RATE as f64, up));
+
+    // A softer mallet on one note (longer contact) makes that note quieter at the mode, and
+    // NaN modulation is ignored.
+    let hard = render(&mut engine(&bank, RATE), &[on(69, 1)], 0.1, 64).0;
+    let soft_events = [
+        on(69, 1),
+        NoteEvent::Modulate {
+            time: 0,
+            id: 1,
+            modulation: VoiceModulation::HardnessMs(20.0),
+        },
+        NoteEvent::Modulate {
+            time: 0,
+            id: 1,
+            modulation: VoiceModulation::HardnessMs(f32::NAN),
+        },
+    ];
+    let soft = render(&mut engine(&bank, RATE), &soft_events, 0.1, 64).0;
+    assert!(
+        peak(&soft) < 0.5 * peak(&hard),
+        "soft {} against hard {}",
+        peak(&soft),
+        peak(&hard)
+    );
+}
+
+#[test]
+fn input_gain_changes_glide_instead_of_stepping() {
+    // An impulse right after the input gain jumps 20 dB excites the modes with about the old
+    // gain; one 0.2 s later with the new gain.
+    let bank = sine_like_bank();
+    let response = |delay: usize| {
+        let mut e = engine(&bank, RATE);
+        let (mut l, mut r) = (vec![0.0; 64], vec![0.0; 64]);
+        let mut x = vec![0.0; 64];
+        // Wake the input voice with a tiny signal at the old gain.
+        x[0] = 1e-6;
+        e.process(&[], Some(&x), &mut l, &mut r);
+        let mut c = e.controls().clone();
+        c.input_gain_db += 20.0;
+        e.set_controls(&c);
+        let mut out = Vec::new();
+        for b in 0..(delay / 64 + 8) {
+            let mut x = vec![0.0; 64];
+            if b == delay / 64 {
+                x[delay % 64] = 0.01;
+            }
+            e.process(&[], Some(&x), &mut l, &mut r);
+            out.extend_from_slice(&l);
+        }
+        peak(&out[delay..])
+    };
+    let (early, late) = (response(3), response(9_600));
+    let ratio = late / early;
+    assert!(
+        ratio > 8.0 && ratio < 10.5,
+        "early {early}, late {late}: ratio {ratio}"
+    );
 }

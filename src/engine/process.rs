@@ -29,14 +29,19 @@ impl Engine {
         let mut next_event = 0;
         let mut pos = 0;
         while pos < len {
+            self.block_pos = pos as u32;
             if self.clock.is_multiple_of(CONTROL_PERIOD as u64) {
                 self.control_tick();
             }
+            let first_event = next_event;
             while next_event < events.len()
                 && (events[next_event].time() as usize).min(len - 1) <= pos
             {
                 self.apply_event(events[next_event]);
                 next_event += 1;
+            }
+            if next_event > first_event {
+                self.make_pending_strikes();
             }
             let to_tick = CONTROL_PERIOD - (self.clock % CONTROL_PERIOD as u64) as usize;
             let to_event = events
@@ -51,6 +56,8 @@ impl Engine {
             self.clock += run as u64;
             pos += run;
         }
+        // Voices ended outside `process` (bank swaps) end at the start of the next block.
+        self.block_pos = 0;
     }
 
     /// Natural logs of the decay multiplier and the tilt the controls ask for.
@@ -74,6 +81,7 @@ impl Engine {
         s.log_damping = log_damping;
         s.tilt = tilt;
         s.gain = db_to_gain(self.controls.output_gain_db);
+        s.input_gain = db_to_gain(self.controls.input_gain_db);
         s.weights = lane_weights(self.controls.width);
         s.weight_target = s.weights;
         s.weight_ramp_left = 0;
@@ -159,8 +167,15 @@ impl Engine {
         let release = self.release_decay();
         let version = self.damping_version;
         let num_voices = self.voices.len();
-        let (controls, bank, decay, rate) =
-            (&self.controls, &self.bank, &self.decay, self.sample_rate_hz);
+        let no_overrides = VoiceOverrides::default();
+        let (controls, bank, decay, rate, ended, time) = (
+            &self.controls,
+            &self.bank,
+            &self.decay,
+            self.sample_rate_hz,
+            &mut self.ended,
+            self.block_pos,
+        );
         for (i, v) in self
             .voices
             .iter_mut()
@@ -183,18 +198,18 @@ impl Engine {
                     self.input_dormant = true;
                 }
                 if v.modes.num_live() == 0 {
-                    v.free();
+                    end_voice(v, ended, time);
                     continue;
                 }
             }
-            let key = if is_input { input_key } else { v.key };
-            let expression = v.tuning_semitones as f64 * std::f64::consts::LN_2 / 12.0;
-            v.log_pitch = step_towards(
-                v.log_pitch,
-                target_log_pitch(controls, bank.root_key, key) + expression,
-                pitch_k,
-                1e-6,
-            );
+            let (key, overrides) = if is_input {
+                (input_key, &no_overrides)
+            } else {
+                (v.key, &v.overrides)
+            };
+            let target =
+                target_log_pitch(controls, bank.root_key, key, overrides) + expression_log_pitch(v);
+            v.log_pitch = step_towards(v.log_pitch, target, pitch_k, 1e-6);
             let tuning = tuning_of(v, version, release);
             if v.applied != Some(tuning) {
                 v.retune(bank, decay, rate, tuning);
@@ -209,12 +224,12 @@ impl Engine {
 
     fn apply_event(&mut self, event: NoteEvent) {
         match event {
-            NoteEvent::On { key, velocity, .. } if velocity > 0.0 && velocity.is_finite() => {
-                self.note_on(key, velocity.min(1.0))
+            NoteEvent::On { note, velocity, .. } if velocity > 0.0 && velocity.is_finite() => {
+                self.note_on(note, velocity.min(1.0))
             }
-            NoteEvent::On { key, .. } | NoteEvent::Off { key, .. } => {
+            NoteEvent::On { note, .. } | NoteEvent::Off { note, .. } => {
                 for i in 0..self.voices.len() {
-                    if self.voices[i].state == VoiceState::Held && self.voices[i].key == key {
+                    if self.voices[i].state == VoiceState::Held && note.names(&self.voices[i]) {
                         self.release(i);
                     }
                 }
@@ -227,39 +242,52 @@ impl Engine {
                 }
             }
             NoteEvent::Expression {
-                key, expression, ..
+                note, expression, ..
             } => {
                 for v in self
                     .voices
                     .iter_mut()
-                    .filter(|v| v.is_sounding() && v.key == key)
+                    .filter(|v| v.is_sounding() && note.names(v))
                 {
-                    match expression {
-                        NoteExpression::Tuning(semitones) if semitones.is_finite() => {
-                            v.tuning_semitones =
-                                semitones.clamp(-MAX_EXPRESSION_SEMITONES, MAX_EXPRESSION_SEMITONES)
-                        }
-                        NoteExpression::Pressure(p) if p.is_finite() => {
-                            v.pressure = p.clamp(0.0, 1.0)
-                        }
-                        _ => {}
-                    }
+                    v.express(expression);
                 }
             }
-            NoteEvent::Choke { key, .. } => {
+            NoteEvent::ChannelExpression {
+                channel,
+                expression,
+                ..
+            } => {
                 for v in self
                     .voices
                     .iter_mut()
-                    .filter(|v| v.is_sounding() && v.key == key)
+                    .filter(|v| v.is_sounding() && v.channel == channel)
                 {
-                    v.free();
+                    v.express(expression);
                 }
             }
-            NoteEvent::AllSoundOff { .. } => {
-                for v in self.voices.iter_mut().chain(self.input_voice.as_mut()) {
-                    v.free();
+            NoteEvent::Modulate { id, modulation, .. } => {
+                let Some(modulation) = modulation.sanitized() else {
+                    return;
+                };
+                for v in self
+                    .voices
+                    .iter_mut()
+                    .filter(|v| v.is_sounding() && v.id == Some(id))
+                {
+                    v.modulate(modulation);
                 }
             }
+            NoteEvent::Choke { note, .. } => {
+                let time = self.block_pos;
+                for v in self
+                    .voices
+                    .iter_mut()
+                    .filter(|v| v.is_sounding() && note.names(v))
+                {
+                    end_voice(v, &mut self.ended, time);
+                }
+            }
+            NoteEvent::AllSoundOff { .. } => self.end_all_voices(),
         }
     }
 
@@ -291,13 +319,13 @@ impl Engine {
             .expect("a sounding voice")
     }
 
-    /// The voice a note on `key` plays: the one still ringing on that key, a free one, or one
+    /// The voice `note` plays: the one still ringing on its key and channel, a free one, or one
     /// freed by stealing the quietest.
-    fn voice_for(&mut self, key: u8) -> usize {
+    fn voice_for(&mut self, note: Note) -> usize {
         if let Some(i) = self
             .voices
             .iter()
-            .position(|v| v.is_sounding() && v.key == key)
+            .position(|v| v.is_sounding() && v.key == note.key && v.channel == note.channel)
         {
             return i;
         }
@@ -316,49 +344,86 @@ impl Engine {
                     .total_cmp(&self.voices[b].fade_gain)
             })
             .expect("voices are allocated");
-        self.voices[i].free();
+        end_voice(&mut self.voices[i], &mut self.ended, self.block_pos);
         i
     }
 
-    fn note_on(&mut self, key: u8, velocity: f32) {
+    /// Starts `note` on a voice; the strike itself waits for the other events at this sample.
+    fn note_on(&mut self, note: Note, velocity: f32) {
+        let i = self.voice_for(note);
+        let v = &mut self.voices[i];
+        let fresh = v.state == VoiceState::Free;
+        if fresh {
+            self.allocations += 1;
+            v.key = note.key;
+            v.channel = note.channel;
+            v.age = self.allocations;
+            v.id = note.id;
+        } else if v.id != note.id {
+            // The new note takes over the ringing voice: the old one has ended for the host.
+            if v.id.is_some() && self.ended.len() < self.ended.capacity() {
+                self.ended.push(EndedVoice {
+                    time: self.block_pos,
+                    note: Note {
+                        key: v.key,
+                        channel: v.channel,
+                        id: v.id,
+                    },
+                });
+            }
+            v.id = note.id;
+        }
+        // A new note starts without the last one's per-note expression and modulation (its
+        // pitch glides back).
+        v.tuning_semitones = 0.0;
+        v.pressure = 0.0;
+        v.overrides = VoiceOverrides::default();
+        v.state = VoiceState::Held;
+        v.pending_strike = Some(PendingStrike { velocity, fresh });
+        self.last_key = Some(note.key);
+    }
+
+    /// Makes the strikes of the notes started at this sample.
+    fn make_pending_strikes(&mut self) {
+        for i in 0..self.voices.len() {
+            if let Some(p) = self.voices[i].pending_strike.take() {
+                self.strike(i, p);
+            }
+        }
+    }
+
+    /// Strikes voice `i` with the engine's controls and the voice's own.
+    fn strike(&mut self, i: usize, pending: PendingStrike) {
         if self.decay_stale != Stale::Fresh {
             self.rebuild_decay_table();
         }
-        let i = self.voice_for(key);
-        let fresh = self.voices[i].state == VoiceState::Free;
-        if fresh {
-            self.allocations += 1;
-            let v = &mut self.voices[i];
-            v.key = key;
-            v.age = self.allocations;
-        }
-        self.last_key = Some(key);
-        let target = target_log_pitch(&self.controls, self.bank.root_key, key);
+        let release = self.release_decay();
+        let c = &self.controls;
         let v = &mut self.voices[i];
-        if fresh {
-            v.log_pitch = target;
+        let o = v.overrides;
+        if pending.fresh {
+            v.log_pitch =
+                target_log_pitch(c, self.bank.root_key, v.key, &o) + expression_log_pitch(v);
         }
-        // A new note starts without the last one's per-note expression (its pitch glides back).
-        v.tuning_semitones = 0.0;
-        v.pressure = 0.0;
-        v.state = VoiceState::Held;
-        let tuning = tuning_of(&self.voices[i], self.damping_version, self.release_decay());
+        let tuning = tuning_of(v, self.damping_version, release);
 
         let c = &self.controls;
         let vary = c.position_variation;
-        let (x, y) = if vary > 0.0 {
-            (
-                c.strike_x + vary * self.rng.bipolar(),
-                c.strike_y + vary * self.rng.bipolar(),
-            )
-        } else {
-            (c.strike_x, c.strike_y)
-        };
+        let (mut x, mut y) = (
+            o.strike_x.unwrap_or(c.strike_x),
+            o.strike_y.unwrap_or(c.strike_y),
+        );
+        if vary > 0.0 {
+            x += vary * self.rng.bipolar();
+            y += vary * self.rng.bipolar();
+        }
         let weights = self.bank.positions.weights(x, y);
         // Force: velocity^(2 s); contact: up to 4x longer for soft notes.
+        let velocity = pending.velocity;
         let amplitude = velocity.powf(2.0 * c.velocity_sensitivity);
-        let contact_ms = (c.hardness_ms * 4f32.powf(c.velocity_to_hardness * (1.0 - velocity)))
-            .clamp(0.05, 20.0);
+        let hardness_ms = o.hardness_ms.unwrap_or(c.hardness_ms);
+        let contact_ms =
+            (hardness_ms * 4f32.powf(c.velocity_to_hardness * (1.0 - velocity))).clamp(0.05, 20.0);
         let len = (contact_ms as f64 * 1e-3 * self.sample_rate_hz)
             .round()
             .max(1.0) as u32;
@@ -401,7 +466,7 @@ impl Engine {
                     }
                 }
                 if v.fade_gain <= 0.0 {
-                    v.free();
+                    end_voice(v, &mut self.ended, self.block_pos);
                 }
             } else {
                 v.modes.process(self.kernel, drive, acc);
@@ -448,11 +513,15 @@ impl Engine {
             }
             return;
         };
-        let gain = db_to_gain(self.controls.input_gain_db);
+        // Smoothed per sample, so automation of the input gain does not zipper.
+        let target_gain = db_to_gain(self.controls.input_gain_db);
+        let gain_k = (1.0 - (-1.0 / (INPUT_GAIN_SMOOTHING_S * self.sample_rate_hz)).exp()) as f32;
+        let gain = &mut self.smoothed.input_gain;
         let x = &mut self.excitation[..n];
         let mut heard = false;
         for (xi, &s) in x.iter_mut().zip(input) {
-            *xi = if s.is_finite() { gain * s } else { 0.0 };
+            *gain += (target_gain - *gain) * gain_k;
+            *xi = if s.is_finite() { *gain * s } else { 0.0 };
             heard |= *xi != 0.0;
         }
         if heard {
@@ -465,7 +534,12 @@ impl Engine {
                 let key = self
                     .last_key
                     .unwrap_or(self.bank.root_key.round().clamp(0.0, 127.0) as u8);
-                let target = target_log_pitch(&self.controls, self.bank.root_key, key);
+                let target = target_log_pitch(
+                    &self.controls,
+                    self.bank.root_key,
+                    key,
+                    &VoiceOverrides::default(),
+                );
                 let weights = self
                     .bank
                     .positions
@@ -516,12 +590,20 @@ fn step_towards(current: f64, target: f64, k: f64, snap: f64) -> f64 {
     }
 }
 
-/// The pitch (natural log of the frequency ratio) a voice on `key` is heading for.
-fn target_log_pitch(c: &Controls, root_key: f64, key: u8) -> f64 {
+/// The pitch (natural log of the frequency ratio) a voice on `key` with `overrides` is heading
+/// for, before per-note expression.
+fn target_log_pitch(c: &Controls, root_key: f64, key: u8, overrides: &VoiceOverrides) -> f64 {
+    let fine_tune_cents = overrides.fine_tune_cents.unwrap_or(c.fine_tune_cents);
+    let size_ratio = overrides.size_ratio.unwrap_or(c.size_ratio);
     let semitones = c.key_tracking as f64 * (key as f64 - root_key)
-        + c.fine_tune_cents as f64 / 100.0
+        + fine_tune_cents as f64 / 100.0
         + c.pitch_bend_semitones as f64;
-    semitones * std::f64::consts::LN_2 / 12.0 - (c.size_ratio as f64).ln()
+    semitones * std::f64::consts::LN_2 / 12.0 - (size_ratio as f64).ln()
+}
+
+/// The pitch offset of a voice's per-note tuning, as a natural log of the frequency ratio.
+fn expression_log_pitch(v: &Voice) -> f64 {
+    v.tuning_semitones as f64 * std::f64::consts::LN_2 / 12.0
 }
 
 /// The tuning voice `v` should have, given the engine's decay table version and the release decay.

@@ -4,6 +4,7 @@ use std::f64::consts::TAU;
 
 use super::position::PositionWeights;
 use super::prepared::PreparedBank;
+use super::{NoteExpression, VoiceModulation, MAX_EXPRESSION_SEMITONES};
 use crate::dsp::coeffs::{t60_to_decay, ModeCoeffs, MAX_FREQ_RATIO};
 use crate::dsp::{Exciter, ExciterKind, ResonatorBank};
 
@@ -28,6 +29,31 @@ pub enum VoiceState {
     Fading,
 }
 
+/// Controls a voice holds in place of the engine's (CLAP polyphonic modulation); `None` follows
+/// the engine.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct VoiceOverrides {
+    /// Fine tune in cents.
+    pub fine_tune_cents: Option<f32>,
+    /// Size ratio.
+    pub size_ratio: Option<f32>,
+    /// Strike position, first axis.
+    pub strike_x: Option<f32>,
+    /// Strike position, second axis.
+    pub strike_y: Option<f32>,
+    /// Mallet contact time in milliseconds.
+    pub hardness_ms: Option<f32>,
+}
+
+/// A strike waiting for the other events at its sample.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PendingStrike {
+    /// Velocity, 0 to 1.
+    pub velocity: f32,
+    /// Whether the voice was free: its pitch starts at its target instead of gliding there.
+    pub fresh: bool,
+}
+
 /// The parameters a voice's coefficients were last computed with.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Tuning {
@@ -48,6 +74,15 @@ pub struct Voice {
     pub state: VoiceState,
     /// MIDI key that struck it.
     pub key: u8,
+    /// MIDI channel of the note.
+    pub channel: u8,
+    /// The host's id for the note, if it gave one.
+    pub id: Option<i32>,
+    /// Controls this voice holds in place of the engine's.
+    pub overrides: VoiceOverrides,
+    /// Velocity of a strike to make once every event at the current sample is in (so
+    /// modulation sent with the note-on shapes the strike).
+    pub pending_strike: Option<PendingStrike>,
     /// Order of allocation, to break ties when stealing.
     pub age: u64,
     /// The resonators.
@@ -72,6 +107,10 @@ impl Voice {
         Self {
             state: VoiceState::Free,
             key: 0,
+            channel: 0,
+            id: None,
+            overrides: VoiceOverrides::default(),
+            pending_strike: None,
             age: 0,
             modes: ResonatorBank::new(num_modes),
             exciter: Exciter::new(seed),
@@ -97,6 +136,33 @@ impl Voice {
         self.fade_gain = 1.0;
         self.tuning_semitones = 0.0;
         self.pressure = 0.0;
+        self.id = None;
+        self.overrides = VoiceOverrides::default();
+        self.pending_strike = None;
+    }
+
+    /// Applies a per-note expression (non-finite values are ignored).
+    pub fn express(&mut self, expression: NoteExpression) {
+        match expression {
+            NoteExpression::Tuning(semitones) if semitones.is_finite() => {
+                self.tuning_semitones =
+                    semitones.clamp(-MAX_EXPRESSION_SEMITONES, MAX_EXPRESSION_SEMITONES)
+            }
+            NoteExpression::Pressure(p) if p.is_finite() => self.pressure = p.clamp(0.0, 1.0),
+            _ => {}
+        }
+    }
+
+    /// Holds a control of its own in place of the engine's (already sanitised).
+    pub fn modulate(&mut self, modulation: VoiceModulation) {
+        let o = &mut self.overrides;
+        match modulation {
+            VoiceModulation::FineTuneCents(v) => o.fine_tune_cents = Some(v),
+            VoiceModulation::SizeRatio(v) => o.size_ratio = Some(v),
+            VoiceModulation::StrikeX(v) => o.strike_x = Some(v),
+            VoiceModulation::StrikeY(v) => o.strike_y = Some(v),
+            VoiceModulation::HardnessMs(v) => o.hardness_ms = Some(v),
+        }
     }
 
     /// Recomputes the coefficients of every live mode for `tuning`: angles scale with pitch,

@@ -2,21 +2,26 @@
 //! does the rest. The instrument and the effect share everything but their [`Kind`].
 
 mod bank_loader;
+mod events;
 mod kind;
+mod poly;
 
 use std::marker::PhantomData;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Arc, RwLock};
 
 use crossbeam_channel::{Receiver, Sender};
+use nice_plug::midi::{Channel, Key, VoiceID};
 use nice_plug::prelude::*;
 
 pub use bank_loader::{bank_from_state, build_engine, LoadedEngine, DEFAULT_FACTORY_BANK};
 pub use kind::{Effect, Instrument, Kind};
 
 use crate::dsp::onset::OnsetDetector;
-use crate::engine::{Engine, NoteEvent as EngineEvent, NoteExpression};
+use crate::engine::{EndedVoice, Engine, NoteEvent as EngineEvent, MAX_POLYPHONY};
 use crate::params::{InputMode, ModalParams};
+use events::{ControlChange, Expression};
+use poly::PolyTable;
 
 /// The instrument plugin.
 pub type ModalResonator = ModalPlugin<Instrument>;
@@ -28,6 +33,20 @@ const MAX_EVENTS: usize = 2048;
 
 /// Lowest sample rate the engine runs at, in Hz.
 const MIN_SAMPLE_RATE_HZ: f32 = 8_000.0;
+
+/// How long the bank that was playing fades out when another is loaded, in seconds.
+const BANK_CROSSFADE_S: f32 = 0.05;
+
+/// Notes whose polyphonic modulation is tracked (the engine's voices, counting those fading).
+const POLY_NOTES: usize = 2 * MAX_POLYPHONY;
+
+/// The engine that was playing before a bank swap, fading out.
+struct Outgoing {
+    /// The engine.
+    engine: Box<Engine>,
+    /// Its gain now, 1 down to 0.
+    gain: f32,
+}
 
 /// Work for the background thread.
 pub enum Task {
@@ -75,18 +94,24 @@ pub struct ModalPlugin<K: Kind> {
     requested_generation: u64,
     /// Note events of the current block, in time order.
     events: Vec<EngineEvent>,
+    /// Note events of the part of the block being rendered, timed from its start.
+    segment_events: Vec<EngineEvent>,
+    /// Channel-wide controller changes of the current block, in time order.
+    changes: Vec<(u32, ControlChange)>,
+    /// The host's polyphonic modulation offsets, per note id.
+    poly: PolyTable,
+    /// The engine that was playing before the last bank swap, while it fades out.
+    outgoing: Option<Outgoing>,
+    /// Output of the outgoing engine.
+    outgoing_out: [Vec<f32>; 2],
     /// Mono mix of the audio input.
     input: Vec<f32>,
     /// Dry input of the effect.
     dry: [Vec<f32>; 2],
     /// Onsets of the input in trigger mode.
     onsets: OnsetDetector,
-    /// Pitch bend, -1 to 1.
-    bend: f32,
-    /// Mod wheel, 0 to 1.
-    mod_wheel: f32,
-    /// Channel pressure, 0 to 1.
-    pressure: f32,
+    /// Where the player's controllers are.
+    expression: Expression,
     /// Last key struck, if any: the pitch of onsets (else the bank's root).
     last_key: Option<u8>,
     /// Dry/wet mix at the end of the last block; `None` after a reset (no ramp needed).
@@ -109,12 +134,15 @@ impl<K: Kind> Default for ModalPlugin<K> {
             pending_trash: None,
             requested_generation: 0,
             events: Vec::with_capacity(MAX_EVENTS),
+            segment_events: Vec::with_capacity(MAX_EVENTS),
+            changes: Vec::with_capacity(MAX_EVENTS),
+            poly: PolyTable::new(POLY_NOTES),
+            outgoing: None,
+            outgoing_out: [Vec::new(), Vec::new()],
             input: Vec::new(),
             dry: [Vec::new(), Vec::new()],
             onsets: OnsetDetector::new(48_000.0),
-            bend: 0.0,
-            mod_wheel: 0.0,
-            pressure: 0.0,
+            expression: Expression::default(),
             last_key: None,
             wet: None,
             _kind: PhantomData,
@@ -129,8 +157,9 @@ impl<K: Kind> ModalPlugin<K> {
     }
 
     /// Swaps in an engine the background thread finished, and hands old engines back to it.
-    /// Returns whether any engine went to the trash (the background thread should drop it).
-    fn take_loaded_engine(&mut self) -> bool {
+    /// The engine that was playing fades out over [`BANK_CROSSFADE_S`]. Returns whether any
+    /// engine went to the trash (the background thread should drop it).
+    fn take_loaded_engine(&mut self, context: &mut impl ProcessContext<Self>) -> bool {
         let mut trashed = false;
         if let Some(old) = self.pending_trash.take() {
             trashed |= self.discard(old);
@@ -141,15 +170,26 @@ impl<K: Kind> ModalPlugin<K> {
         let rate = f32::from_bits(self.shared.sample_rate_bits.load(Ordering::Acquire));
         while let Ok(loaded) = self.loaded_rx.try_recv() {
             // Superseded by a newer request, or built before the host changed the sample rate:
-            // discard it. Otherwise swap it in and discard the old one.
+            // discard it. Otherwise swap it in and let the old one fade out.
             let current = loaded.generation == self.requested_generation
                 && loaded.engine.sample_rate_hz() == rate;
             let old = if current {
-                self.engine.replace(loaded.engine)
+                match self.engine.replace(loaded.engine) {
+                    Some(old) if !old.is_silent() => {
+                        // A fade already under way is cut short by the newer swap.
+                        let cut = self.outgoing.replace(Outgoing {
+                            engine: old,
+                            gain: 1.0,
+                        });
+                        cut.map(|o| o.engine)
+                    }
+                    old => old,
+                }
             } else {
                 Some(loaded.engine)
             };
-            if let Some(old) = old {
+            if let Some(mut old) = old {
+                self.end_engine(&mut old, 0, context);
                 trashed |= self.discard(old);
                 if self.pending_trash.is_some() {
                     break;
@@ -157,6 +197,19 @@ impl<K: Kind> ModalPlugin<K> {
             }
         }
         trashed
+    }
+
+    /// Silences `engine` for good, telling the host its notes ended at sample `time`.
+    fn end_engine(
+        &mut self,
+        engine: &mut Engine,
+        time: u32,
+        context: &mut impl ProcessContext<Self>,
+    ) {
+        engine.end_all_voices();
+        for ended in engine.take_ended_voices() {
+            report_ended(&mut self.poly, context, EndedVoice { time, ..ended });
+        }
     }
 
     /// Hands `engine` to the background thread to be dropped there, or keeps it for later when
@@ -171,91 +224,8 @@ impl<K: Kind> ModalPlugin<K> {
         }
     }
 
-    /// Reads the block's note events into `self.events` (sample times within the block) and
-    /// updates the channel's expression.
-    fn read_events(&mut self, context: &mut impl ProcessContext<Self>) {
-        self.events.clear();
-        while let Some(event) = context.next_event() {
-            let mapped = match event {
-                NoteEvent::NoteOn {
-                    timing,
-                    key,
-                    velocity,
-                    ..
-                } => {
-                    let key = key.number_or_middle_c();
-                    if velocity > 0.0 {
-                        self.last_key = Some(key);
-                    }
-                    Some(EngineEvent::On {
-                        time: timing,
-                        key,
-                        velocity,
-                    })
-                }
-                // A wildcard key means every note.
-                NoteEvent::NoteOff { timing, key, .. } => Some(match key.number() {
-                    Some(key) => EngineEvent::Off { time: timing, key },
-                    None => EngineEvent::AllNotesOff { time: timing },
-                }),
-                NoteEvent::Choke { timing, key, .. } => Some(match key.number() {
-                    Some(key) => EngineEvent::Choke { time: timing, key },
-                    None => EngineEvent::AllSoundOff { time: timing },
-                }),
-                NoteEvent::PolyTuning {
-                    timing,
-                    key,
-                    tuning,
-                    ..
-                } => Some(EngineEvent::Expression {
-                    time: timing,
-                    key: key.number_or_middle_c(),
-                    expression: NoteExpression::Tuning(tuning),
-                }),
-                NoteEvent::PolyPressure {
-                    timing,
-                    key,
-                    pressure,
-                    ..
-                } => Some(EngineEvent::Expression {
-                    time: timing,
-                    key: key.number_or_middle_c(),
-                    expression: NoteExpression::Pressure(pressure),
-                }),
-                NoteEvent::MidiPitchBend { value, .. } => {
-                    self.bend = (value * 2.0 - 1.0).clamp(-1.0, 1.0);
-                    None
-                }
-                NoteEvent::MidiChannelPressure { pressure, .. } => {
-                    self.pressure = pressure.clamp(0.0, 1.0);
-                    None
-                }
-                NoteEvent::MidiCC {
-                    timing, cc, value, ..
-                } => match cc {
-                    control_change::MODULATION_MSB => {
-                        self.mod_wheel = value.clamp(0.0, 1.0);
-                        None
-                    }
-                    control_change::ALL_SOUND_OFF => {
-                        Some(EngineEvent::AllSoundOff { time: timing })
-                    }
-                    control_change::ALL_NOTES_OFF => {
-                        Some(EngineEvent::AllNotesOff { time: timing })
-                    }
-                    _ => None,
-                },
-                _ => None,
-            };
-            if let Some(e) = mapped {
-                if self.events.len() < MAX_EVENTS {
-                    self.events.push(e);
-                }
-            }
-        }
-    }
-
-    /// Adds a strike at each onset of the input (trigger mode), keeping events in time order.
+    /// Adds a strike at each onset of `self.input[..n]` (trigger mode) to the segment's events,
+    /// keeping them in time order.
     fn add_onsets(&mut self, n: usize) {
         let threshold = util::db_to_gain(self.params.trigger_threshold.value());
         let retrigger_s = self.params.retrigger.value() * 1e-3;
@@ -263,21 +233,122 @@ impl<K: Kind> ModalPlugin<K> {
         let key = self
             .last_key
             .unwrap_or(root.round().clamp(0.0, 127.0) as u8);
-        let events = &mut self.events;
+        let events = &mut self.segment_events;
         self.onsets
             .process(&self.input[..n], threshold, retrigger_s, |onset| {
                 if events.len() < MAX_EVENTS {
-                    let event = EngineEvent::On {
-                        time: onset.time,
-                        key,
-                        velocity: onset.strength,
-                    };
+                    let event = EngineEvent::on(onset.time, key, onset.strength);
                     // Insert in time order; after events at the same time.
                     let at = events.partition_point(|e| e.time() <= onset.time);
                     events.insert(at, event);
                 }
             });
     }
+
+    /// Renders samples `start..end` of the block (at most the announced maximum block): the
+    /// engine (and an outgoing one fading out), the audio input and the effect's dry/wet mix.
+    /// `self.segment_events` holds the segment's events, timed from `start`.
+    fn render_segment(
+        &mut self,
+        channels: &mut [&mut [f32]],
+        exciter: Option<&[&mut [f32]]>,
+        start: usize,
+        end: usize,
+        context: &mut impl ProcessContext<Self>,
+    ) {
+        let n = end - start;
+        // The audio input: the effect's main input, or the instrument's exciter input.
+        let mode = self.params.input_mode.value();
+        let mut have_input = false;
+        if K::IS_EFFECT {
+            for (dry, channel) in self.dry.iter_mut().zip(channels.iter()) {
+                dry[..n].copy_from_slice(&channel[start..end]);
+            }
+            mix_to_mono(&self.dry[0][..n], &self.dry[1][..n], &mut self.input[..n]);
+            have_input = true;
+        } else if let Some(ex) = exciter {
+            if ex.len() >= 2 && ex[0].len() >= end && ex[1].len() >= end {
+                mix_to_mono(&ex[0][start..end], &ex[1][start..end], &mut self.input[..n]);
+                have_input = true;
+            }
+        }
+        if have_input && mode == InputMode::Trigger {
+            self.add_onsets(n);
+        }
+        let drive = (have_input && mode == InputMode::Direct).then_some(&self.input[..n]);
+
+        let e = &self.expression;
+        let controls = self.params.controls(e.bend, e.mod_wheel, e.pressure);
+        let (left, rest) = channels.split_at_mut(1);
+        let (out_l, out_r) = (&mut left[0][start..end], &mut rest[0][start..end]);
+        let Some(engine) = self.engine.as_mut() else {
+            return;
+        };
+        engine.set_controls(&controls);
+        engine.process(&self.segment_events, drive, out_l, out_r);
+        for ended in engine.take_ended_voices() {
+            let time = ended.time + start as u32;
+            report_ended(&mut self.poly, context, EndedVoice { time, ..ended });
+        }
+
+        if let Some(outgoing) = self.outgoing.as_mut() {
+            let [ol, or] = &mut self.outgoing_out;
+            let (ol, or) = (&mut ol[..n], &mut or[..n]);
+            outgoing.engine.set_controls(&controls);
+            outgoing.engine.process(&[], drive, ol, or);
+            let rate = outgoing.engine.sample_rate_hz();
+            let step = 1.0 / (BANK_CROSSFADE_S * rate);
+            for ((l, r), (a, b)) in out_l
+                .iter_mut()
+                .zip(out_r.iter_mut())
+                .zip(ol.iter().zip(or.iter()))
+            {
+                outgoing.gain = (outgoing.gain - step).max(0.0);
+                *l += outgoing.gain * a;
+                *r += outgoing.gain * b;
+            }
+            if outgoing.gain <= 0.0 || outgoing.engine.is_silent() {
+                let mut done = self.outgoing.take().expect("checked above").engine;
+                self.end_engine(&mut done, (end - 1) as u32, context);
+                if self.discard(done) {
+                    context.execute_background(Task::CollectGarbage);
+                }
+            }
+        }
+
+        if K::IS_EFFECT {
+            // Ramp from the last segment's mix to this one's, so automation does not zipper.
+            let to = self.params.dry_wet.value();
+            let from = self.wet.unwrap_or(to);
+            let step = (to - from) / n as f32;
+            for (channel, dry) in channels.iter_mut().zip(&self.dry) {
+                for (i, (out, d)) in channel[start..end].iter_mut().zip(&dry[..n]).enumerate() {
+                    let wet = from + step * (i + 1) as f32;
+                    *out = wet * *out + (1.0 - wet) * d;
+                }
+            }
+            self.wet = Some(to);
+        }
+    }
+}
+
+/// Tells the host a note ended (CLAP note end; needed for polyphonic modulation) and forgets its
+/// modulation.
+fn report_ended<P: Plugin>(
+    poly: &mut PolyTable,
+    context: &mut impl ProcessContext<P>,
+    ended: EndedVoice,
+) {
+    if let Some(id) = ended.note.id {
+        poly.remove(id);
+    }
+    // Hosts without an output event list (or with a full one) do not need to know.
+    let _ = context.try_send_event(NoteEvent::VoiceTerminated {
+        timing: ended.time,
+        voice_id: ended.note.id.map_or(VoiceID::Wildcard, VoiceID::ID),
+        channel: Channel::Number(ended.note.channel),
+        key: Key::Number(ended.note.key),
+    });
 }
 
 impl<K: Kind> Plugin for ModalPlugin<K> {
@@ -354,6 +425,9 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
             .store(max_block as u32, Ordering::Release);
         self.input = vec![0.0; max_block];
         self.dry = [vec![0.0; max_block], vec![0.0; max_block]];
+        self.outgoing_out = [vec![0.0; max_block], vec![0.0; max_block]];
+        self.outgoing = None;
+        self.poly.clear();
         self.onsets = OnsetDetector::new(rate);
         // Build the engine here, synchronously, so offline renders start with the right bank.
         self.requested_generation = self.params.bank.generation.load(Ordering::Acquire);
@@ -395,6 +469,11 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         }
         self.onsets.reset();
         self.wet = None;
+        // A reset ends every note at once, for the host as well.
+        if let Some(outgoing) = self.outgoing.take() {
+            self.discard(outgoing.engine);
+        }
+        self.poly.clear();
         // Pitch bend, mod wheel and pressure are where the player left them: a host resets
         // the plugin on every start of processing, and the wheel has not moved.
     }
@@ -410,63 +489,58 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
             self.requested_generation = generation;
             context.execute_background(Task::LoadBank(generation));
         }
-        if self.take_loaded_engine() {
+        if self.take_loaded_engine(context) {
             context.execute_background(Task::CollectGarbage);
         }
         self.read_events(context);
 
         let n = buffer.samples();
         let channels = buffer.as_slice();
-        if self.engine.is_none() || channels.len() < 2 || n > self.input.len() {
+        if self.engine.is_none() || channels.len() < 2 || self.input.is_empty() {
             for channel in channels.iter_mut() {
                 channel.fill(0.0);
             }
             return ProcessStatus::Normal;
         }
+        let exciter = aux.inputs.first().map(|b| b.as_slice_immutable());
 
-        // The audio input: the effect's main input, or the instrument's exciter input.
-        let mode = self.params.input_mode.value();
-        let mut have_input = false;
-        if K::IS_EFFECT {
-            for (dry, channel) in self.dry.iter_mut().zip(channels.iter()) {
-                dry[..n].copy_from_slice(&channel[..n]);
-            }
-            mix_to_mono(&self.dry[0][..n], &self.dry[1][..n], &mut self.input[..n]);
-            have_input = true;
-        } else if let Some(exciter) = aux.inputs.first_mut() {
-            let ex = exciter.as_slice_immutable();
-            if ex.len() >= 2 && ex[0].len() >= n && ex[1].len() >= n {
-                mix_to_mono(&ex[0][..n], &ex[1][..n], &mut self.input[..n]);
-                have_input = true;
-            }
-        }
-        if have_input && mode == InputMode::Trigger {
-            self.add_onsets(n);
-        }
-        let drive = (have_input && mode == InputMode::Direct).then_some(&self.input[..n]);
-
-        let controls = self
-            .params
-            .controls(self.bend, self.mod_wheel, self.pressure);
-        let engine = self.engine.as_mut().expect("checked above");
-        engine.set_controls(&controls);
-        let (left, rest) = channels.split_at_mut(1);
-        engine.process(&self.events, drive, &mut left[0][..n], &mut rest[0][..n]);
-
-        if K::IS_EFFECT {
-            // Ramp from the last block's mix to this one's, so automation does not zipper.
-            let to = self.params.dry_wet.value();
-            let from = self.wet.unwrap_or(to);
-            let step = (to - from) / n as f32;
-            for (channel, dry) in channels.iter_mut().zip(&self.dry) {
-                for (i, (out, d)) in channel[..n].iter_mut().zip(&dry[..n]).enumerate() {
-                    let wet = from + step * (i + 1) as f32;
-                    *out = wet * *out + (1.0 - wet) * d;
+        // Render in segments: one ends where a channel-wide controller moves (so bends and
+        // wheels act from their sample, to the engine's control grid) and none is longer than
+        // the buffers sized for the announced maximum block.
+        let max_segment = self.input.len();
+        let (mut start, mut next_event, mut next_change) = (0, 0, 0);
+        while start < n {
+            while let Some(&(time, change)) = self.changes.get(next_change) {
+                if time as usize > start {
+                    break;
                 }
+                self.expression.apply(change);
+                next_change += 1;
             }
-            self.wet = Some(to);
+            let mut end = (start + max_segment).min(n);
+            if let Some(&(time, _)) = self.changes.get(next_change) {
+                end = end.min(time as usize);
+            }
+            self.segment_events.clear();
+            while let Some(event) = self.events.get(next_event) {
+                let time = event.time() as usize;
+                if time >= end && end < n {
+                    break;
+                }
+                let at = time.saturating_sub(start).min(end - start - 1);
+                self.segment_events.push(event.at(at as u32));
+                next_event += 1;
+            }
+            self.render_segment(channels, exciter, start, end, context);
+            start = end;
         }
-        if engine.is_silent() {
+        // Controllers timed past the block's end (hosts should not send them) act now.
+        for &(_, change) in &self.changes[next_change..] {
+            self.expression.apply(change);
+        }
+
+        let silent = self.engine.as_ref().is_none_or(|e| e.is_silent()) && self.outgoing.is_none();
+        if silent {
             ProcessStatus::Normal
         } else {
             ProcessStatus::KeepAlive
@@ -487,6 +561,12 @@ impl<K: Kind> ClapPlugin for ModalPlugin<K> {
     const CLAP_MANUAL_URL: Option<&'static str> = None;
     const CLAP_SUPPORT_URL: Option<&'static str> = None;
     const CLAP_FEATURES: &'static [ClapFeature] = K::CLAP_FEATURES;
+    // Notes on one key and channel share a voice (a struck object restruck), so voices never
+    // overlap.
+    const CLAP_POLY_MODULATION_CONFIG: Option<PolyModulationConfig> = Some(PolyModulationConfig {
+        max_voice_capacity: MAX_POLYPHONY as u32,
+        supports_overlapping_voices: false,
+    });
 }
 
 impl<K: Kind> Vst3Plugin for ModalPlugin<K> {

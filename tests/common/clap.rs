@@ -112,7 +112,15 @@ pub enum Send {
     Midi([u8; 3]),
     /// A CLAP note expression on a key.
     Expression(NoteExpressionType, u16, f64),
+    /// A note-on with a channel and a note id: key, channel, id, velocity.
+    NoteOn(u16, u16, u32, f64),
+    /// Polyphonic modulation of a parameter (by string id) on one note id, in CLAP's
+    /// normalised units.
+    Mod(&'static str, u32, f64),
 }
+
+/// A note end the plugin reported: absolute sample time, note id (-1 for none), key, channel.
+pub type NoteEnd = (usize, i32, i16, i16);
 
 /// What one session with a plugin produced.
 pub struct Session {
@@ -123,6 +131,8 @@ pub struct Session {
     pub statuses: Vec<ProcessStatus>,
     /// Time spent inside the plugin's process calls.
     pub process_time: Duration,
+    /// The note ends the plugin reported.
+    pub note_ends: Vec<NoteEnd>,
 }
 
 /// What a session plays.
@@ -145,6 +155,8 @@ pub struct Script<'a> {
     pub rate: f64,
     /// Block sizes, used in turn.
     pub blocks: &'a [usize],
+    /// The largest block announced at activation (default: the largest of `blocks`).
+    pub max_block: Option<usize>,
 }
 
 impl<'a> Script<'a> {
@@ -159,6 +171,7 @@ impl<'a> Script<'a> {
             swap: None,
             rate: RATE,
             blocks: &[BLOCK],
+            max_block: None,
         }
     }
 }
@@ -180,22 +193,31 @@ pub fn session(
     })
 }
 
-/// Renders `from..to` of `script` on an audio thread of its own.
+/// Renders `script` on an audio thread of its own. When the script has a swap, the audio thread
+/// waits between blocks at its sample while `load` runs on this (the main) thread, as a host
+/// loading a state while it plays.
+#[allow(clippy::too_many_arguments)] // test plumbing: every output has its own place
 fn render_span(
     script: &Script,
     processor: StoppedPluginAudioProcessor<Host>,
     span: std::ops::Range<usize>,
+    load: &mut dyn FnMut(),
     left: &mut Vec<f32>,
     right: &mut Vec<f32>,
     statuses: &mut Vec<ProcessStatus>,
     process_time: &mut Duration,
+    note_ends: &mut Vec<NoteEnd>,
 ) -> StoppedPluginAudioProcessor<Host> {
+    let reached = AtomicBool::new(false);
+    let loaded = AtomicBool::new(false);
     std::thread::scope(|s| {
-        s.spawn(|| {
+        let audio = s.spawn(|| {
             let mut p = processor.start_processing().unwrap();
             let mut in_ports = AudioPorts::with_capacity(2, 1);
             let mut out_ports = AudioPorts::with_capacity(2, 1);
-            let mut out_events = EventBuffer::new();
+            // Room for every note end of a block, so the plugin's pushes never allocate here
+            // (the allocation-checking build would count them as its own).
+            let mut out_events = EventBuffer::with_capacity(4_096);
             let mut start = span.start;
             let mut block = 0;
             while start < span.end {
@@ -231,6 +253,17 @@ fn render_span(
                             Pckn::new(0u16, 0u16, key, Match::All),
                             kind,
                             value,
+                        )),
+                        Send::NoteOn(key, channel, id, vel) => evs.push(&NoteOnEvent::new(
+                            time,
+                            Pckn::new(0u16, channel, key, id),
+                            vel,
+                        )),
+                        Send::Mod(param, id, amount) => evs.push(&ParamModEvent::new(
+                            time,
+                            param_id(param),
+                            Pckn::new(Match::All, Match::All, Match::All, id),
+                            amount,
                         )),
                     }
                 }
@@ -268,22 +301,43 @@ fn render_span(
                     )
                     .expect("process succeeds");
                 *process_time += started.elapsed();
+                for e in out_events.iter() {
+                    if let Some(end) = e.as_event::<NoteEndEvent>() {
+                        let pckn = end.pckn();
+                        note_ends.push((
+                            start + end.header().time() as usize,
+                            pckn.raw_note_id(),
+                            pckn.raw_key(),
+                            pckn.raw_channel(),
+                        ));
+                    }
+                }
                 statuses.push(status);
                 left.extend_from_slice(&out[0]);
                 right.extend_from_slice(&out[1]);
                 start += n;
-                if script
-                    .swap
-                    .is_some_and(|(at, _)| start >= at && start < at + 64 * BLOCK)
-                {
-                    // Give the background thread time to build the new bank's engine.
-                    std::thread::sleep(std::time::Duration::from_millis(2));
+                if let Some((at, _)) = script.swap {
+                    if start >= at && !reached.swap(true, Ordering::SeqCst) {
+                        while !loaded.load(Ordering::SeqCst) {
+                            std::thread::sleep(Duration::from_millis(1));
+                        }
+                    }
+                    if start >= at && start < at + 64 * BLOCK {
+                        // Give the background thread time to build the new bank's engine.
+                        std::thread::sleep(Duration::from_millis(2));
+                    }
                 }
             }
             p.stop_processing()
-        })
-        .join()
-        .unwrap()
+        });
+        if script.swap.is_some() {
+            while !reached.load(Ordering::SeqCst) && !audio.is_finished() {
+                std::thread::sleep(Duration::from_millis(1));
+            }
+            load();
+            loaded.store(true, Ordering::SeqCst);
+        }
+        audio.join().unwrap()
     })
 }
 
@@ -319,7 +373,9 @@ pub fn run(script: &Script) -> Session {
             )
             .expect("state loads");
     }
-    let max_block = script.blocks.iter().copied().max().unwrap_or(BLOCK);
+    let max_block = script
+        .max_block
+        .unwrap_or_else(|| script.blocks.iter().copied().max().unwrap_or(BLOCK));
     let config = PluginAudioConfiguration {
         sample_rate: script.rate,
         min_frames_count: 1,
@@ -332,35 +388,26 @@ pub fn run(script: &Script) -> Session {
     let mut right = Vec::with_capacity(script.samples);
     let mut statuses = Vec::new();
     let mut process_time = Duration::ZERO;
-    let swap_at = script
-        .swap
-        .map_or(script.samples, |(at, _)| at.min(script.samples));
+    let mut note_ends = Vec::new();
+    let handle = instance.plugin_handle();
+    let mut load = || {
+        if let Some((_, bytes)) = script.swap {
+            state_ext
+                .load(&handle, &mut std::io::Cursor::new(bytes.to_vec()))
+                .expect("state loads");
+        }
+    };
     processor = render_span(
         script,
         processor,
-        0..swap_at,
+        0..script.samples,
+        &mut load,
         &mut left,
         &mut right,
         &mut statuses,
         &mut process_time,
+        &mut note_ends,
     );
-    if let Some((_, bytes)) = script.swap {
-        state_ext
-            .load(
-                &instance.plugin_handle(),
-                &mut std::io::Cursor::new(bytes.to_vec()),
-            )
-            .expect("state loads");
-        processor = render_span(
-            script,
-            processor,
-            swap_at..script.samples,
-            &mut left,
-            &mut right,
-            &mut statuses,
-            &mut process_time,
-        );
-    }
     if instance.access_shared_handler(|h| h.callback_requested.swap(false, Ordering::SeqCst)) {
         instance.call_on_main_thread_callback();
     }
@@ -375,6 +422,7 @@ pub fn run(script: &Script) -> Session {
         state: saved,
         statuses,
         process_time,
+        note_ends,
     }
 }
 

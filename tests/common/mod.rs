@@ -108,11 +108,7 @@ pub fn shift(event: NoteEvent, offset: u32) -> NoteEvent {
 
 /// A note-on at absolute sample `time`.
 pub fn on(time: u32, key: u8, velocity: f32) -> NoteEvent {
-    NoteEvent::On {
-        time,
-        key,
-        velocity,
-    }
+    NoteEvent::on(time, key, velocity)
 }
 
 /// Largest absolute sample.
@@ -149,6 +145,26 @@ pub fn pitch_hz(x: &[f32], rate: f64, lo_hz: f64, hi_hz: f64) -> f64 {
     let (a, b, c) = (ac(l - 1), ac(l), ac(l + 1));
     let shift = 0.5 * (a - c) / (a - 2.0 * b + c);
     rate / (l as f64 + shift)
+}
+
+/// Frequency of the strongest spectral peak of `x` between `lo_hz` and `hi_hz`, to about
+/// 0.01 Hz: for mixtures, where autocorrelation picks the wrong period.
+pub fn spectral_peak_hz(x: &[f32], rate: f64, lo_hz: f64, hi_hz: f64) -> f64 {
+    let strongest = |from: f64, to: f64, step: f64| {
+        let mut best = (from, f64::MIN);
+        let mut f = from;
+        while f <= to {
+            let m = magnitude_at(x, rate, f);
+            if m > best.1 {
+                best = (f, m);
+            }
+            f += step;
+        }
+        best.0
+    };
+    let coarse = strongest(lo_hz, hi_hz, 1.0);
+    let fine = strongest(coarse - 1.0, coarse + 1.0, 0.05);
+    strongest(fine - 0.05, fine + 0.05, 0.005)
 }
 
 /// Magnitude of the spectrum of `x` at `freq_hz` (a single DFT bin at any frequency).
