@@ -15,6 +15,8 @@
 pub mod bar;
 pub mod bell;
 pub mod bessel;
+mod disc;
+mod lattice;
 pub mod membrane;
 pub mod plate;
 mod positions;
