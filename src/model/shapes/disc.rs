@@ -10,6 +10,17 @@ use super::ShapedMode;
 /// Below this `|sin(m theta)|` a position is taken to be on a nodal diameter of the sine twin.
 const ON_AXIS_EPS: f64 = 1e-9;
 
+/// The factor that gives `R(r) cos(m theta)` unit mean square over the unit disc, from
+/// `integral = int_0^1 R(r)^2 r dr`: the mean square is `2 integral` for `m = 0` and `integral`
+/// otherwise (the mean of `cos^2` is a half).
+pub(super) fn unit_mean_square_scale(m: usize, integral: f64) -> f64 {
+    if m == 0 {
+        1.0 / (2.0 * integral).sqrt()
+    } else {
+        1.0 / integral.sqrt()
+    }
+}
+
 /// Strike positions on a disc, in polar form.
 pub(super) struct DiscPoints {
     /// `(r, theta)` of each position: `r` in fractions of the radius, `theta` in radians.
@@ -46,7 +57,8 @@ impl DiscPoints {
     }
 
     /// Pushes onto `modes` the mode of order `m` at `freq_hz` whose radial part is `radial`,
-    /// scaled so that `radial(r) cos(m theta)` has unit mean square over the disc. Adds the sine twin when a position needs it.
+    /// scaled so that `radial(r) cos(m theta)` has unit mean square over the disc (see
+    /// [`unit_mean_square_scale`]). Adds the sine twin when a position needs it.
     pub fn push_modes(
         &self,
         modes: &mut Vec<ShapedMode>,
