@@ -18,6 +18,7 @@ pub mod bell;
 pub mod bessel;
 pub mod cantilever;
 pub mod circular_plate;
+pub mod design;
 mod disc;
 mod lattice;
 pub mod membrane;
@@ -31,6 +32,9 @@ pub mod string;
 pub use bar::{Bar, TunedBar, MARIMBA_RATIOS, VIBRAPHONE_RATIOS, XYLOPHONE_RATIOS};
 pub use bell::{BellPartial, TunedBell, TUNED_BELL_PARTIALS};
 pub use circular_plate::{CircularPlate, PlateEdge};
+pub use design::{
+    design_bank, BankDesign, Dimension, ObjectKind, ObjectSpec, BAR_TUNINGS, OBJECTS,
+};
 pub use membrane::CircularMembrane;
 pub use plate::RectangularPlate;
 pub use rect_membrane::RectangularMembrane;
