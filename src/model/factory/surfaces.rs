@@ -131,7 +131,6 @@ pub(super) fn objects() -> Vec<FactoryObject> {
             tweaks: Tweaks {
                 hardness_ms: Some(GONG_BEATER_MS),
                 strike_at: Some("third radius"),
-                ..Tweaks::NONE
             },
         },
         FactoryObject {
