@@ -22,6 +22,7 @@ pub mod design;
 mod disc;
 mod lattice;
 pub mod membrane;
+pub mod objects;
 pub mod plate;
 mod positions;
 pub mod rect_membrane;
@@ -32,10 +33,9 @@ pub mod string;
 pub use bar::{Bar, TunedBar, MARIMBA_RATIOS, VIBRAPHONE_RATIOS, XYLOPHONE_RATIOS};
 pub use bell::{BellPartial, TunedBell, TUNED_BELL_PARTIALS};
 pub use circular_plate::{CircularPlate, PlateEdge};
-pub use design::{
-    design_bank, BankDesign, Dimension, ObjectKind, ObjectSpec, BAR_TUNINGS, OBJECTS,
-};
+pub use design::{design_bank, BankDesign};
 pub use membrane::CircularMembrane;
+pub use objects::{Dimension, ObjectKind, ObjectSpec, BAR_TUNINGS, OBJECTS};
 pub use plate::RectangularPlate;
 pub use rect_membrane::RectangularMembrane;
 pub use shape::Shape;
