@@ -419,7 +419,9 @@ fn help_lists_the_subcommands() {
     let out = run(dir.path(), &["--help"]);
     assert!(out.status.success(), "stderr: {}", stderr(&out));
     let help = stdout(&out);
-    for sub in ["play", "render", "validate", "info", "list", "schema"] {
+    for sub in [
+        "play", "render", "fit", "shape", "compress", "validate", "info", "list", "schema",
+    ] {
         assert!(help.contains(sub), "help lacks {sub}: {help}");
     }
 }
@@ -703,4 +705,235 @@ fn fit_rejects_bad_recordings_and_writes_nothing() {
         dir.path(),
         &["notes.wav", "silence.wav", "surround.wav"],
     );
+}
+
+#[test]
+fn shape_builds_a_stated_steel_bar_and_prints_its_summary() {
+    let dir = dir_with_bank();
+    let out = run(
+        dir.path(),
+        &[
+            "shape",
+            "free-free-bar",
+            "--material",
+            "steel",
+            "--length",
+            "0.3",
+            "--width",
+            "0.03",
+            "--thickness",
+            "0.01",
+            "-o",
+            "bar.json",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    // f1 = (4.730^2 / (2 pi 0.3^2)) 0.01 sqrt(200e9 / (12 * 7850)) = 576.50 Hz.
+    assert!(text.contains("root 576.50 Hz"), "{text}");
+    // Modes below 20 kHz: b_n L up to (2 * 8 + 1) pi / 2, at 18.37 kHz.
+    assert!(text.contains("bar.json: 8 modes, 4 positions"), "{text}");
+    let bank = modal_resonator::model::load_bank_file(&dir.path().join("bar.json")).unwrap();
+    assert_eq!(bank.modes.len(), 8);
+    assert_eq!(bank.license, "CC0-1.0");
+    let ratio = bank.modes[1].freq_hz / bank.modes[0].freq_hz;
+    assert!((ratio - 2.756).abs() < 1e-3, "ratio {ratio}");
+}
+
+#[test]
+fn shape_tunes_takes_positions_and_limits() {
+    let dir = dir_with_bank();
+    let out = run(
+        dir.path(),
+        &[
+            "shape",
+            "circular-plate",
+            "--edge",
+            "clamped",
+            "--material",
+            "ceramic",
+            "--root-note",
+            "A4",
+            "--positions",
+            "centre=0,0; rim side=0.8,0.3",
+            "--modes",
+            "20",
+            "--name",
+            "Test disc",
+            "-o",
+            "disc.json",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let bank = modal_resonator::model::load_bank_file(&dir.path().join("disc.json")).unwrap();
+    assert_eq!(bank.name, "Test disc");
+    assert!((bank.root_hz.unwrap() - 440.0).abs() < 1e-9);
+    assert_eq!(bank.modes.len(), 20);
+    assert_eq!(bank.positions.len(), 2);
+    let source = bank.source.unwrap();
+    assert_eq!(
+        (source["material"].as_str(), source["edge"].as_str()),
+        (Some("porcelain"), Some("clamped"))
+    );
+    let tuned = run(
+        dir.path(),
+        &[
+            "shape",
+            "stiff-string",
+            "--tune-hz",
+            "110",
+            "-o",
+            "string.json",
+        ],
+    );
+    assert!(tuned.status.success(), "{}", stderr(&tuned));
+    assert!(
+        stdout(&tuned).contains("root 110.00 Hz (A2)"),
+        "{}",
+        stdout(&tuned)
+    );
+}
+
+#[test]
+fn shape_refuses_bad_names_and_dimensions_cleanly() {
+    let dir = dir_with_bank();
+    let out = run(dir.path(), &["shape", "kazoo", "-o", "x.json"]);
+    assert_failed_cleanly(
+        &out,
+        &[
+            "unknown object \"kazoo\"",
+            "expected one of ideal-string",
+            "circular-plate",
+        ],
+        dir.path(),
+        &[],
+    );
+    let out = run(
+        dir.path(),
+        &["shape", "bell", "--material", "cheese", "-o", "x.json"],
+    );
+    assert_failed_cleanly(
+        &out,
+        &[
+            "unknown material \"cheese\"",
+            "steel",
+            "porcelain (ceramic)",
+        ],
+        dir.path(),
+        &[],
+    );
+    let out = run(
+        dir.path(),
+        &["shape", "free-free-bar", "--radius", "0.1", "-o", "x.json"],
+    );
+    assert_failed_cleanly(
+        &out,
+        &["free-free-bar does not take it", "--length"],
+        dir.path(),
+        &[],
+    );
+    let out = run(
+        dir.path(),
+        &[
+            "shape",
+            "free-free-bar",
+            "--thickness",
+            "-1",
+            "-o",
+            "x.json",
+        ],
+    );
+    assert_failed_cleanly(&out, &["expected a number above 0"], dir.path(), &[]);
+    let out = run(
+        dir.path(),
+        &[
+            "shape",
+            "ideal-string",
+            "--positions",
+            "1.5",
+            "-o",
+            "x.json",
+        ],
+    );
+    assert_failed_cleanly(&out, &["positions[0]", "[0, 1]"], dir.path(), &[]);
+    let help = run(dir.path(), &["shape", "--help"]);
+    let text = stdout(&help);
+    for word in [
+        "clamped-free-bar",
+        "rectangular-membrane",
+        "acrylic",
+        "hardwood",
+    ] {
+        assert!(text.contains(word), "shape --help lacks {word}: {text}");
+    }
+}
+
+#[test]
+fn compress_merges_and_drops_and_reports() {
+    let dir = tempfile::tempdir().unwrap();
+    // 2000 and 2002 Hz are within the 5 Hz limen; the 3 kHz mode is 100 dB down.
+    let mut bank = common::simple_bank(&[
+        (2000.0, 4.0, 1.0),
+        (2002.0, 4.0, 0.5),
+        (2500.0, 5.0, 0.3),
+        (3000.0, 6.0, 1e-5),
+    ]);
+    bank.root_hz = Some(2000.0);
+    modal_resonator::model::save_bank_file(&bank, &dir.path().join("bank.json")).unwrap();
+    let out = run(dir.path(), &["compress", "bank.json", "-o", "small.json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("4 modes -> 2 modes (merged 1, dropped 1)"),
+        "{}",
+        stdout(&out)
+    );
+    let small = modal_resonator::model::load_bank_file(&dir.path().join("small.json")).unwrap();
+    assert_eq!(small.modes.len(), 2);
+    assert!((small.modes[0].gains[0] - 1.5).abs() < 1e-12);
+    let kept = run(
+        dir.path(),
+        &[
+            "compress",
+            "bank.json",
+            "-o",
+            "kept.json",
+            "--keep-weak",
+            "--limen-scale",
+            "0",
+        ],
+    );
+    assert!(
+        stdout(&kept).contains("4 modes -> 4 modes (merged 0, dropped 0)"),
+        "{}",
+        stdout(&kept)
+    );
+    // Factory banks by name; the input is never overwritten.
+    let plate = run(dir.path(), &["compress", "steel-plate", "-o", "plate.json"]);
+    assert!(plate.status.success(), "{}", stderr(&plate));
+    assert!(
+        stdout(&plate).starts_with("300 modes -> "),
+        "{}",
+        stdout(&plate)
+    );
+    let same = run(dir.path(), &["compress", "bank.json", "-o", "bank.json"]);
+    assert!(!same.status.success());
+    assert!(stderr(&same).contains("overwrite"), "{}", stderr(&same));
+    let bad = run(
+        dir.path(),
+        &[
+            "compress",
+            "bank.json",
+            "-o",
+            "x.json",
+            "--drop-below-db",
+            "6",
+        ],
+    );
+    assert!(!bad.status.success());
+    assert!(
+        stderr(&bad).contains("drop_below_db = 6"),
+        "{}",
+        stderr(&bad)
+    );
+    assert!(!dir.path().join("x.json").exists());
 }

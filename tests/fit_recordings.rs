@@ -11,7 +11,7 @@ use std::path::PathBuf;
 
 use common::recordings::{RealRecording, REAL_RECORDINGS};
 use modal_resonator::model::fit::{compare, fit_bank, FitOptions};
-use modal_resonator::model::{load_bank_file, save_bank_file, Bank};
+use modal_resonator::model::{load_bank_file, save_bank_file, Bank, BankDefaults};
 use serde_json::json;
 
 /// Position name of the single strike in each recording.
@@ -33,12 +33,32 @@ fn preset_path(r: &RealRecording) -> PathBuf {
         .join(format!("{}.json", r.slug))
 }
 
-/// The fitted bank with where it came from: licence, credit and package in its metadata.
+/// Mallet contact time in ms the fitted banks play with by default: the shortest, nearly an
+/// impulse, since the recording's gains already hold the real mallet's spectrum.
+const FITTED_HARDNESS_MS: f64 = 0.05;
+
+/// The fitted bank with where it came from (licence, credit and package in its metadata), a
+/// description, its root (the fitted mode nearest the note it is played as) and defaults.
 fn with_provenance(mut bank: Bank, r: &RealRecording) -> Bank {
     bank.description = format!(
-        "{} fitted from one recorded strike by modal-resonator fit.",
-        r.object
+        "{} Fitted from one recorded strike by modal-resonator fit.",
+        r.about
     );
+    let root = bank
+        .modes
+        .iter()
+        .map(|m| m.freq_hz)
+        .min_by(|a, b| {
+            (a - r.root_near_hz)
+                .abs()
+                .total_cmp(&(b - r.root_near_hz).abs())
+        })
+        .expect("a fitted bank has modes");
+    bank.root_hz = Some(root);
+    bank.defaults = Some(BankDefaults {
+        hardness_ms: Some(FITTED_HARDNESS_MS),
+        ..BankDefaults::default()
+    });
     bank.author = format!("Fitted from a recording by {}", r.credit);
     bank.license = r.license.to_string();
     let source = bank.source.get_or_insert_with(Default::default);
