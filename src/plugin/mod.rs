@@ -9,15 +9,18 @@ mod poly;
 use std::marker::PhantomData;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Arc, RwLock};
+use std::time::Instant;
 
 use crossbeam_channel::{Receiver, Sender};
 use nice_plug::midi::{Channel, Key, VoiceID};
 use nice_plug::prelude::*;
+use nice_plug_egui::{EguiEditor, EguiEditorState};
 
 pub use bank_loader::{bank_from_state, build_engine, LoadedEngine, DEFAULT_FACTORY_BANK};
 pub use kind::{Effect, Instrument, Kind};
 
 use crate::dsp::onset::OnsetDetector;
+use crate::editor::{self, EditorApp, EditorLinks, EditorShared, AUDITION_NOTE_ID};
 use crate::engine::{EndedVoice, Engine, NoteEvent as EngineEvent, MAX_POLYPHONY};
 use crate::params::{InputMode, ModalParams};
 use events::{ControlChange, Expression};
@@ -116,6 +119,14 @@ pub struct ModalPlugin<K: Kind> {
     last_key: Option<u8>,
     /// Dry/wet mix at the end of the last block; `None` after a reset (no ramp needed).
     wet: Option<f32>,
+    /// The editor's size and whether it is open.
+    editor_state: Arc<EguiEditorState>,
+    /// Meters for the editor and its strike pad's requests.
+    editor_shared: Arc<EditorShared>,
+    /// The key of the strike pad's note while it is held.
+    audition_key: Option<u8>,
+    /// The bank generation of the engine playing.
+    playing_generation: u64,
     _kind: PhantomData<K>,
 }
 
@@ -145,6 +156,10 @@ impl<K: Kind> Default for ModalPlugin<K> {
             expression: Expression::default(),
             last_key: None,
             wet: None,
+            editor_state: editor::default_state(),
+            editor_shared: Arc::new(EditorShared::new()),
+            audition_key: None,
+            playing_generation: 0,
             _kind: PhantomData,
         }
     }
@@ -174,6 +189,7 @@ impl<K: Kind> ModalPlugin<K> {
             let current = loaded.generation == self.requested_generation
                 && loaded.engine.sample_rate_hz() == rate;
             let old = if current {
+                self.playing_generation = loaded.generation;
                 match self.engine.replace(loaded.engine) {
                     Some(old) if !old.is_silent() => {
                         // A fade already under way is cut short by the newer swap.
@@ -342,6 +358,9 @@ fn report_ended<P: Plugin>(
     if let Some(id) = ended.note.id {
         poly.remove(id);
     }
+    if ended.note.id == Some(AUDITION_NOTE_ID) {
+        return;
+    }
     // Hosts without an output event list (or with a full one) do not need to know.
     let _ = context.try_send_event(NoteEvent::VoiceTerminated {
         timing: ended.time,
@@ -361,12 +380,23 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
     const MIDI_INPUT: MidiConfig = MidiConfig::MidiCCs;
     const SAMPLE_ACCURATE_AUTOMATION: bool = false;
 
-    type Editor = ();
+    type Editor = EguiEditor<EditorApp>;
     type SysExMessage = ();
     type BackgroundTask = Task;
 
     fn params(&self) -> Arc<dyn Params> {
         self.params.clone()
+    }
+
+    fn editor(&mut self, _async_executor: AsyncExecutor<Self>) -> Option<Self::Editor> {
+        let shared = self.shared.clone();
+        let app = EditorApp::new(EditorLinks {
+            params: self.params.clone(),
+            shared: self.editor_shared.clone(),
+            bank_error: Arc::new(move || shared.bank_error.read().ok().and_then(|e| e.clone())),
+            is_effect: K::IS_EFFECT,
+        });
+        editor::create(K::NAME, self.editor_state.clone(), app)
     }
 
     fn task_executor(&mut self) -> TaskExecutor<Self> {
@@ -431,6 +461,7 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         self.onsets = OnsetDetector::new(rate);
         // Build the engine here, synchronously, so offline renders start with the right bank.
         self.requested_generation = self.params.bank.generation.load(Ordering::Acquire);
+        self.playing_generation = self.requested_generation;
         let json = self
             .params
             .bank
@@ -484,6 +515,8 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         aux: &mut AuxiliaryBuffers,
         context: &mut impl ProcessContext<Self>,
     ) -> ProcessStatus {
+        // Meters are measured only while the editor shows them.
+        let started = self.editor_state.is_open().then(Instant::now);
         let generation = self.params.bank.generation.load(Ordering::Acquire);
         if generation != self.requested_generation {
             self.requested_generation = generation;
@@ -537,6 +570,17 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         // Controllers timed past the block's end (hosts should not send them) act now.
         for &(_, change) in &self.changes[next_change..] {
             self.expression.apply(change);
+        }
+
+        if let Some(started) = started {
+            let rate = f32::from_bits(self.shared.sample_rate_bits.load(Ordering::Relaxed));
+            self.editor_shared.measure_block(
+                self.engine.as_deref(),
+                self.playing_generation,
+                channels,
+                started.elapsed(),
+                rate,
+            );
         }
 
         let silent = self.engine.as_ref().is_none_or(|e| e.is_silent()) && self.outgoing.is_none();
