@@ -40,7 +40,9 @@ const SIDE_PANEL_SHARE: f32 = 0.25;
 /// Narrowest and widest default width of the side panels, in points.
 const SIDE_PANEL_WIDTH: (f32, f32) = (220.0, 320.0);
 /// Largest share of the window's width a side panel can be resized to.
-const SIDE_PANEL_MAX_SHARE: f32 = 0.35;
+const SIDE_PANEL_MAX_SHARE: f32 = 0.28;
+/// Share of the central area's width the strike pad takes, beside the mode editor.
+const STRIKE_PAD_SHARE: f32 = 0.6;
 
 /// Where the widgets were drawn, in points.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -266,7 +268,7 @@ impl EditorApp {
             .size_range(side_range.clone())
             .show(ui, |ui| {
                 ScrollArea::vertical().id_salt("parameters").show(ui, |ui| {
-                    params_panel::show(ui, &params, setter, self.is_effect)
+                    params_panel::show(ui, &params, setter, self.is_effect, side_width)
                 });
             });
         let mut loaded = None;
@@ -459,15 +461,21 @@ impl EditorApp {
             .iter()
             .map(|p| p.name.clone())
             .collect();
-        ui.columns(2, |columns| {
-            let ui = &mut columns[0];
-            ui.label(RichText::new("Strike pad").strong());
-            let size = ui.available_size();
-            self.pad
-                .show(ui, size, self.session.positions(), &names, host);
-            let ui = &mut columns[1];
-            ui.label(RichText::new("Selected mode").strong());
-            mode_editor::show(ui, &mut self.session, self.view.selected, &weights);
+        let below = ui.available_size();
+        let pad_width = (below.x * STRIKE_PAD_SHARE).floor();
+        let layout = egui::Layout::top_down(egui::Align::Min);
+        ui.horizontal_top(|ui| {
+            ui.allocate_ui_with_layout(vec2(pad_width, below.y), layout, |ui| {
+                ui.label(RichText::new("Strike pad").strong());
+                let size = vec2(pad_width, ui.available_height());
+                self.pad
+                    .show(ui, size, self.session.positions(), &names, host);
+            });
+            ui.separator();
+            ui.allocate_ui_with_layout(ui.available_size(), layout, |ui| {
+                ui.label(RichText::new("Selected mode").strong());
+                mode_editor::show(ui, &mut self.session, self.view.selected, &weights);
+            });
         });
     }
 }

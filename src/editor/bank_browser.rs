@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use egui::{Align, Layout, RichText, ScrollArea, TextEdit, Ui};
+use egui::{vec2, Align, Layout, RichText, ScrollArea, TextEdit, Ui};
 use nice_plug::prelude::ParamSetter;
 
 use super::session::BankSession;
@@ -233,7 +233,8 @@ impl BankBrowser {
 
         ui.label(RichText::new("Load a file").strong());
         // Right to left, so the text field takes exactly the width the button leaves.
-        ui.with_layout(Layout::right_to_left(Align::Center), |ui| {
+        let row = vec2(ui.available_width(), ui.spacing().interact_size.y);
+        ui.allocate_ui_with_layout(row, Layout::right_to_left(Align::Center), |ui| {
             let load = ui.button("Load").clicked();
             let edit = TextEdit::singleline(&mut self.path_text)
                 .hint_text("/path/to/bank.json")
@@ -252,7 +253,7 @@ impl BankBrowser {
         if self.save_name.is_empty() {
             self.save_name = format!("{} edit", session.bank().name);
         }
-        ui.with_layout(Layout::right_to_left(Align::Center), |ui| {
+        ui.allocate_ui_with_layout(row, Layout::right_to_left(Align::Center), |ui| {
             let hint = if session.has_mutes() {
                 "Save the modes heard (muted ones left out) in the user folder"
             } else {

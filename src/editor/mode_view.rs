@@ -407,7 +407,7 @@ fn draw_axes(painter: &egui::Painter, map: &Mapping, ppp: f32) {
         painter.text(
             pos2(plot.left() - 4.0, y),
             Align2::RIGHT_CENTER,
-            format!("{db:.0}"),
+            format!("{:.0}", db + 0.0),
             font.clone(),
             style::LABEL,
         );
@@ -415,7 +415,7 @@ fn draw_axes(painter: &egui::Painter, map: &Mapping, ppp: f32) {
         painter.text(
             pos2(plot.right() + 4.0, y),
             Align2::LEFT_CENTER,
-            format!("{level:.0}"),
+            format!("{:.0}", level + 0.0),
             font.clone(),
             style::LIVE.gamma_multiply(0.8),
         );

@@ -8,8 +8,8 @@ use nice_plug_egui::widgets::ParamSlider;
 
 use crate::params::ModalParams;
 
-/// Share of the panel's width a slider takes.
-const SLIDER_SHARE: f32 = 0.42;
+/// Room the label and value columns need beside a slider, in points.
+const LABEL_AND_VALUE_WIDTH: f32 = 215.0;
 /// Narrowest and widest slider, in points.
 const SLIDER_WIDTH: (f32, f32) = (70.0, 150.0);
 
@@ -130,9 +130,16 @@ fn control_name(c: &Control) -> String {
     }
 }
 
-/// Draws the parameter groups.
-pub fn show(ui: &mut Ui, params: &ModalParams, setter: &ParamSetter, is_effect: bool) {
-    let width = (ui.available_width() * SLIDER_SHARE).clamp(SLIDER_WIDTH.0, SLIDER_WIDTH.1);
+/// Draws the parameter groups in a panel `panel_width` points wide (the width the panel starts
+/// with: sizing the sliders by the width left would let the panel creep frame by frame).
+pub fn show(
+    ui: &mut Ui,
+    params: &ModalParams,
+    setter: &ParamSetter,
+    is_effect: bool,
+    panel_width: f32,
+) {
+    let width = (panel_width - LABEL_AND_VALUE_WIDTH).clamp(SLIDER_WIDTH.0, SLIDER_WIDTH.1);
     ui.label(
         egui::RichText::new("Double-click resets · Shift-drag fine · click a value to type")
             .small()

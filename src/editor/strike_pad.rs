@@ -72,7 +72,12 @@ impl StrikePad {
             vec2(size.x, LINE_HEIGHT)
         };
         let (rect, response) = ui.allocate_exact_size(size, Sense::click_and_drag());
-        let area = rect.shrink(INSET);
+        // Room for the names of the end positions of a line.
+        let area = if two_d {
+            rect.shrink(INSET)
+        } else {
+            rect.shrink2(vec2(3.0 * INSET, INSET))
+        };
         self.area = area;
         let to_screen = |x: f32, y: f32| {
             if two_d {
