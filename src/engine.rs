@@ -496,6 +496,19 @@ impl Engine {
         s
     }
 
+    /// Calls `visit(mode, energy)` for every mode sounding in a voice (the input voice
+    /// included), with its squared amplitude `|z|^2`; a mode sounding in several voices is
+    /// visited once per voice. Modes are numbered as in [`PreparedBank`] (ascending frequency).
+    /// Modes never visited are silent everywhere: truncated, not struck, or above the highest
+    /// frequency played. For meters: does not allocate.
+    pub fn visit_mode_energies(&self, mut visit: impl FnMut(usize, f32)) {
+        for v in self.voices.iter().chain(self.input_voice.as_ref()) {
+            for (mode, energy) in v.modes.live_energies() {
+                visit(mode, energy);
+            }
+        }
+    }
+
     /// Silences every voice at once, reporting each as ended. Does not allocate.
     pub fn end_all_voices(&mut self) {
         for v in self.voices.iter_mut() {

@@ -10,14 +10,17 @@ mod poly;
 use std::marker::PhantomData;
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 use std::sync::{Arc, RwLock};
+use std::time::Instant;
 
 use nice_plug::midi::{Channel, Key, VoiceID};
 use nice_plug::prelude::*;
+use nice_plug_egui::{EguiEditor, EguiEditorState};
 
 pub use bank_loader::{bank_from_state, build_engine, LoadedEngine, DEFAULT_FACTORY_BANK};
 pub use kind::{Effect, Instrument, Kind};
 
 use crate::dsp::onset::OnsetDetector;
+use crate::editor::{self, EditorApp, EditorLinks, EditorShared, AUDITION_NOTE_ID};
 use crate::engine::{EndedVoice, NoteEvent as EngineEvent, MAX_POLYPHONY};
 use crate::params::{InputMode, ModalParams, STATE_FORMAT, STATE_FORMAT_FIELD};
 use engines::Engines;
@@ -104,6 +107,12 @@ pub struct ModalPlugin<K: Kind> {
     last_key: Option<u8>,
     /// Dry/wet mix at the end of the last block; `None` after a reset (no ramp needed).
     wet: Option<f32>,
+    /// The editor's size and whether it is open.
+    editor_state: Arc<EguiEditorState>,
+    /// Meters for the editor and its strike pad's requests.
+    editor_shared: Arc<EditorShared>,
+    /// The key of the strike pad's note while it is held.
+    audition_key: Option<u8>,
     _kind: PhantomData<K>,
 }
 
@@ -126,6 +135,9 @@ impl<K: Kind> Default for ModalPlugin<K> {
             expression: Expression::default(),
             last_key: None,
             wet: None,
+            editor_state: editor::default_state(),
+            editor_shared: Arc::new(EditorShared::new()),
+            audition_key: None,
             _kind: PhantomData,
         }
     }
@@ -266,6 +278,10 @@ fn report_ended<P: Plugin>(
     if let Some(id) = ended.note.id {
         poly.remove(id);
     }
+    // The editor's strike pad auditions are the plugin's own notes: the host never saw them.
+    if ended.note.id == Some(AUDITION_NOTE_ID) {
+        return;
+    }
     // Hosts without an output event list (or with a full one) do not need to know.
     let _ = context.try_send_event(NoteEvent::VoiceTerminated {
         timing: ended.time,
@@ -285,12 +301,23 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
     const MIDI_INPUT: MidiConfig = MidiConfig::MidiCCs;
     const SAMPLE_ACCURATE_AUTOMATION: bool = false;
 
-    type Editor = ();
+    type Editor = EguiEditor<EditorApp>;
     type SysExMessage = ();
     type BackgroundTask = Task;
 
     fn params(&self) -> Arc<dyn Params> {
         self.params.clone()
+    }
+
+    fn editor(&mut self, _async_executor: AsyncExecutor<Self>) -> Option<Self::Editor> {
+        let shared = self.shared.clone();
+        let app = EditorApp::new(EditorLinks {
+            params: self.params.clone(),
+            shared: self.editor_shared.clone(),
+            bank_error: Arc::new(move || shared.bank_error.read().ok().and_then(|e| e.clone())),
+            is_effect: K::IS_EFFECT,
+        });
+        editor::create(K::NAME, self.editor_state.clone(), app)
     }
 
     fn task_executor(&mut self) -> TaskExecutor<Self> {
@@ -434,6 +461,8 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         aux: &mut AuxiliaryBuffers,
         context: &mut impl ProcessContext<Self>,
     ) -> ProcessStatus {
+        // Meters are measured only while the editor shows them.
+        let started = self.editor_state.is_open().then(Instant::now);
         let generation = self.params.bank.generation.load(Ordering::Acquire);
         let failed = self.shared.failed_generation.load(Ordering::Acquire);
         if let Some(generation) = self.engines.request(generation, failed) {
@@ -499,6 +528,15 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         // forgotten.
         if let Some(engine) = self.engines.current.as_ref() {
             self.poly.retain(|id| engine.has_note_id(id));
+        }
+        if let Some(started) = started {
+            self.editor_shared.measure_block(
+                self.engines.current.as_deref(),
+                self.engines.playing_generation,
+                channels,
+                started.elapsed(),
+                rate,
+            );
         }
         let silent = self.engines.current.as_ref().is_none_or(|e| e.is_silent())
             && self.engines.outgoing.is_none();
