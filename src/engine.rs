@@ -522,6 +522,19 @@ impl Engine {
         s
     }
 
+    /// Calls `visit(mode, energy)` for every mode sounding in a voice (the input voice
+    /// included), with its squared amplitude `|z|^2`; a mode sounding in several voices is
+    /// visited once per voice. Modes are numbered as in [`PreparedBank`] (ascending frequency).
+    /// Modes never visited are silent everywhere: truncated, not struck, or above the highest
+    /// frequency played. For meters: does not allocate.
+    pub fn visit_mode_energies(&self, mut visit: impl FnMut(usize, f32)) {
+        for v in self.voices.iter().chain(self.input_voice.as_ref()) {
+            for (mode, energy) in v.modes.live_energies() {
+                visit(mode, energy);
+            }
+        }
+    }
+
     /// Silences every voice at once, reporting each as ended. Does not allocate.
     pub fn end_all_voices(&mut self) {
         for v in self.voices.iter_mut() {
@@ -530,6 +543,31 @@ impl Engine {
         if let Some(v) = self.input_voice.as_mut() {
             v.free();
         }
+    }
+
+    /// The notes of every voice sounding or fading out.
+    pub fn notes(&self) -> impl Iterator<Item = Note> + '_ {
+        self.voices
+            .iter()
+            .filter(|v| v.state != VoiceState::Free)
+            .map(|v| Note {
+                key: v.key,
+                channel: v.channel,
+                id: v.id,
+            })
+    }
+
+    /// Whether a voice sounds for the host's note `id`.
+    pub fn has_note_id(&self, id: i32) -> bool {
+        self.voices
+            .iter()
+            .any(|v| v.is_sounding() && v.id == Some(id))
+    }
+
+    /// Tunes the input voice to `key` (else the bank's root) until a note is played: the last key
+    /// the player struck, carried over to an engine built for a new bank.
+    pub fn set_last_key(&mut self, key: Option<u8>) {
+        self.last_key = key;
     }
 
     /// Hands over the voices that stopped sounding during the last `process` calls (freed,

@@ -5,6 +5,7 @@
 //! through SIMD resonator banks ([`dsp`]); [`render`] drives the same engine offline.
 
 pub mod dsp;
+pub mod editor;
 pub mod engine;
 pub mod model;
 pub mod params;

@@ -35,6 +35,9 @@ pub const MPE_DEFAULT_BEND_RANGE: f32 = 48.0;
 /// Version of the plugin state's own fields; raised when they change meaning.
 pub const STATE_FORMAT: u32 = 1;
 
+/// The state field holding [`STATE_FORMAT`].
+pub const STATE_FORMAT_FIELD: &str = "state-format";
+
 /// Material: the bank as authored, a shortcut, or the Q and tilt knobs.
 #[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MaterialChoice {
@@ -112,6 +115,16 @@ impl BankField {
     pub fn replace(&self, json: String) {
         *self.json.write().unwrap_or_else(|e| e.into_inner()) = json;
         self.generation.fetch_add(1, Ordering::AcqRel);
+    }
+
+    /// Puts back `json`, the bank still playing, in place of the text of `generation` that
+    /// failed to load, so a saved project holds what was heard. Nothing changes if another bank
+    /// has arrived since.
+    pub fn restore(&self, generation: u64, json: &str) {
+        let mut text = self.json.write().unwrap_or_else(|e| e.into_inner());
+        if self.generation.load(Ordering::Acquire) == generation {
+            json.clone_into(&mut text);
+        }
     }
 }
 

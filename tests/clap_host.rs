@@ -756,3 +756,177 @@ fn the_default_bank_peaks_near_minus_6_dbfs_at_its_root() {
     let level = gain_to_db(peak(&s.left).max(peak(&s.right)));
     assert!((level + 6.0).abs() < 1.5, "peak {level} dBFS");
 }
+
+#[test]
+fn the_plugins_list_every_parameter_under_its_stable_id() {
+    for (plugin, extra) in [(INSTRUMENT, 0), (EFFECT, 0)] {
+        let infos = param_infos(plugin);
+        let mut got: Vec<u32> = infos.iter().map(|(id, _)| id.get()).collect();
+        got.sort();
+        let mut want: Vec<u32> = PARAM_IDS.iter().map(|id| param_id(id).get()).collect();
+        want.sort();
+        assert_eq!(got.len(), want.len() + extra, "{plugin:?} lists {infos:?}");
+        assert_eq!(got, want, "{plugin:?}: ids differ from the stable ones");
+        let names: Vec<&str> = infos.iter().map(|(_, n)| n.as_str()).collect();
+        for name in ["Strike position", "Hardness", "Fine tune", "MPE", "Dry/wet"] {
+            assert!(names.contains(&name), "{plugin:?} lacks {name}: {names:?}");
+        }
+    }
+}
+
+#[test]
+fn the_plugins_declare_their_categories() {
+    let factory = entry(Build::Release).get_plugin_factory().unwrap();
+    for d in factory.plugin_descriptors() {
+        let id = d.id().unwrap().to_string_lossy().into_owned();
+        let features: Vec<String> = d
+            .features()
+            .map(|f| f.to_string_lossy().into_owned())
+            .collect();
+        let want: &[&str] = if id.ends_with("instrument") {
+            &["instrument", "synthesizer", "stereo"]
+        } else {
+            &["audio-effect", "filter", "stereo"]
+        };
+        for f in want {
+            assert!(
+                features.iter().any(|g| g == f),
+                "{id} lacks {f}: {features:?}"
+            );
+        }
+        assert!(d.name().is_some() && d.vendor().is_some() && d.version().is_some());
+    }
+}
+
+#[test]
+fn a_host_restart_silences_every_voice_and_forgets_the_test_note() {
+    // Notes ring, the host stops and restarts processing (nice-plug resets the plugin), and
+    // nothing of them is heard after; a tap in trigger mode then plays at the bank's root, not
+    // at the key struck before the reset.
+    let state = state_with(&sine_bank(440.0));
+    // A tap: a decaying burst at 30_000.
+    let tap: Vec<f32> = (0..48_000)
+        .map(|i| match i {
+            30_000..30_400 => {
+                let sign = if i % 2 == 0 { 1.0 } else { -1.0 };
+                0.6 * (-((i - 30_000) as f32) / 60.0).exp() * sign
+            }
+            _ => 0.0,
+        })
+        .collect();
+    let input = [tap.clone(), tap];
+    let s = run(&Script {
+        state: Some(&state),
+        events: &[
+            (0, Send::Param("inmode", 2.0)),
+            (100, Send::On(81, 1.0)),
+            (200, Send::On(76, 1.0)),
+        ],
+        input: Some(&input),
+        restart_at: Some(24_064),
+        ..Script::new(INSTRUMENT, 48_000)
+    });
+    assert!(
+        peak(&s.left[20_000..24_000]) > 0.01,
+        "nothing rang before the restart"
+    );
+    assert!(
+        peak(&s.left[24_064..30_000]) == 0.0,
+        "sound after the restart: {}",
+        peak(&s.left[24_064..30_000])
+    );
+    let struck = &s.left[30_100..];
+    assert!(peak(struck) > 1e-3, "the tap did not strike");
+    let got = spectral_peak_hz(struck, RATE, 300.0, 1_000.0);
+    assert!(
+        (got / 440.0 - 1.0).abs() < 0.002,
+        "the tap played {got} Hz, not the root"
+    );
+}
+
+#[test]
+fn direct_input_rings_at_the_last_note_played() {
+    // Key 76 (E5) struck and released with full damping; noise on the exciter input then rings
+    // the input voice at E5 on the 440 Hz bank.
+    let state = state_with(&sine_bank(440.0));
+    // White noise (a linear congruential generator, so it has no period within the render).
+    let mut seed: u32 = 12_345;
+    let noise: Vec<f32> = (0..48_000)
+        .map(|i| {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            if i < 12_000 {
+                0.0
+            } else {
+                ((seed >> 8) as f32 / (1u32 << 24) as f32 - 0.5) * 0.1
+            }
+        })
+        .collect();
+    let input = [noise.clone(), noise];
+    let s = run(&Script {
+        state: Some(&state),
+        events: &[
+            (0, Send::Param("inmode", 1.0)),
+            (0, Send::Param("reldmp", 1.0)),
+            (100, Send::On(76, 1.0)),
+            (200, Send::Off(76)),
+        ],
+        input: Some(&input),
+        ..Script::new(INSTRUMENT, 48_000)
+    });
+    let driven = &s.left[24_000..];
+    assert!(peak(driven) > 1e-3, "the input did not ring the modes");
+    let want = 440.0 * 2f64.powf(7.0 / 12.0);
+    let got = spectral_peak_hz(driven, RATE, 300.0, 1_000.0);
+    assert!(
+        (got / want - 1.0).abs() < 0.003,
+        "input rings at {got} Hz, want {want}"
+    );
+}
+
+#[test]
+fn the_effect_strikes_at_the_pitch_of_its_midi_notes() {
+    let state = {
+        let first = session(EFFECT, None, &[], None, BLOCK);
+        with_bank(&first.state, &sine_bank(440.0))
+    };
+    let s = run(&Script {
+        state: Some(&state),
+        events: &[(100, Send::On(64, 1.0))],
+        ..Script::new(EFFECT, 24_000)
+    });
+    let x = &s.left[200..];
+    assert!(peak(x) > 0.01, "the effect did not strike on a note");
+    let want = 440.0 * 2f64.powf(-5.0 / 12.0);
+    let got = spectral_peak_hz(x, RATE, 200.0, 800.0);
+    assert!((got / want - 1.0).abs() < 0.002, "{got} Hz, want {want}");
+}
+
+#[test]
+fn a_broken_bank_loaded_while_playing_keeps_the_bank_and_the_state_holds_it() {
+    let state = state_with(&sine_bank(440.0));
+    let good = bank_text(&state);
+    let broken = with_bank_text(&state, &good[..good.len() / 2]);
+    let notes: Vec<(usize, Send)> = (0..8).map(|i| (i * 6_000, Send::On(69, 1.0))).collect();
+    let s = run(&Script {
+        state: Some(&state),
+        events: &notes,
+        swap: Some((12_000, &broken)),
+        ..Script::new(INSTRUMENT, 48_000)
+    });
+    let after = &s.left[36_100..42_000];
+    let got = spectral_peak_hz(after, RATE, 300.0, 600.0);
+    assert!(
+        (got / 440.0 - 1.0).abs() < 0.002,
+        "after the broken bank: {got} Hz"
+    );
+    assert_eq!(
+        bank_text(&s.state),
+        good,
+        "the saved state lost the playing bank"
+    );
+    let saved = String::from_utf8_lossy(&s.state[8..]).into_owned();
+    assert!(
+        saved.contains("\"state-format\":\"1\""),
+        "no state format: {saved}"
+    );
+}

@@ -419,7 +419,9 @@ fn help_lists_the_subcommands() {
     let out = run(dir.path(), &["--help"]);
     assert!(out.status.success(), "stderr: {}", stderr(&out));
     let help = stdout(&out);
-    for sub in ["play", "render", "validate", "info", "list", "schema"] {
+    for sub in [
+        "play", "render", "fit", "shape", "compress", "validate", "info", "list", "schema",
+    ] {
         assert!(help.contains(sub), "help lacks {sub}: {help}");
     }
 }
@@ -427,30 +429,33 @@ fn help_lists_the_subcommands() {
 #[test]
 fn the_standalone_runs_headless_with_the_dummy_backend() {
     // The standalone runs until stopped: start it, let it process for a while, then stop it.
-    let mut child = Command::new(env!("CARGO_BIN_EXE_modal-resonator"))
-        .args([
-            "play",
-            "--backend",
-            "dummy",
-            "--sample-rate",
-            "48000",
-            "--period-size",
-            "256",
-        ])
-        .env_remove("DISPLAY")
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .expect("the binary runs");
-    std::thread::sleep(std::time::Duration::from_secs(2));
-    let still_running = child.try_wait().unwrap().is_none();
-    let _ = child.kill();
-    let out = child.wait_with_output().unwrap();
-    assert!(
-        still_running,
-        "the standalone stopped by itself: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    // Its options work after `play` and with no subcommand at all.
+    let options = [
+        "--backend",
+        "dummy",
+        "--sample-rate",
+        "48000",
+        "--period-size",
+        "256",
+    ];
+    for play in [&["play"][..], &[]] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_modal-resonator"))
+            .args(play.iter().chain(&options))
+            .env_remove("DISPLAY")
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("the binary runs");
+        std::thread::sleep(std::time::Duration::from_secs(2));
+        let still_running = child.try_wait().unwrap().is_none();
+        let _ = child.kill();
+        let out = child.wait_with_output().unwrap();
+        assert!(
+            still_running,
+            "{play:?}: the standalone stopped by itself: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
 }
 
 /// The broken banks of the format tests, each with the JSON path (or position) its error names.
@@ -548,4 +553,387 @@ fn factory_presets_render_and_describe_by_name() {
     let schema = run(dir.path(), &["schema"]);
     let parsed: serde_json::Value = serde_json::from_slice(&schema.stdout).unwrap();
     assert!(parsed.get("properties").is_some());
+}
+
+/// Writes a WAV file of `channels` channels at 48 kHz: a lead-in, then a strike of two modes
+/// (440 Hz and 1234.5 Hz) in every channel, over faint deterministic noise.
+fn write_strike_wav(path: &Path, channels: u16) {
+    let spec = hound::WavSpec {
+        channels,
+        sample_rate: 48_000,
+        bits_per_sample: 16,
+        sample_format: hound::SampleFormat::Int,
+    };
+    let mut writer = hound::WavWriter::create(path, spec).unwrap();
+    let mut seed = 1u32;
+    for n in 0..(1.5 * 48_000.0) as usize {
+        let t = n as f64 / 48_000.0 - 0.05;
+        let tau = std::f64::consts::TAU;
+        let ring = if t >= 0.0 {
+            0.5 * (-3.0 * t).exp() * (tau * 440.0 * t).sin()
+                + 0.2 * (-9.0 * t).exp() * (tau * 1234.5 * t).sin()
+        } else {
+            0.0
+        };
+        for _ in 0..channels {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            let noise = 1e-4 * (seed as f64 / u32::MAX as f64 - 0.5);
+            writer
+                .write_sample(((ring + noise) * 32767.0).round() as i16)
+                .unwrap();
+        }
+    }
+    writer.finalize().unwrap();
+}
+
+#[test]
+fn fit_writes_a_bank_and_a_report_from_recordings() {
+    let dir = dir_with_bank();
+    write_strike_wav(&dir.path().join("edge.wav"), 1);
+    write_strike_wav(&dir.path().join("middle.wav"), 2);
+    let out = run(
+        dir.path(),
+        &[
+            "fit",
+            "edge.wav",
+            "middle.wav=centre",
+            "-o",
+            "fitted.json",
+            "--modes",
+            "8",
+            "--report",
+            "report.json",
+            "--license",
+            "CC0-1.0",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert!(text.contains("log-spectral distance"), "{text}");
+    assert!(text.contains("fitted.json: 2 modes, 2 positions"), "{text}");
+    // The stereo file was mixed to mono, and says so.
+    assert!(stderr(&out).contains("centre: stereo"), "{}", stderr(&out));
+
+    let bank = modal_resonator::model::load_bank_file(&dir.path().join("fitted.json")).unwrap();
+    assert_eq!(bank.name, "fitted");
+    assert_eq!(bank.license, "CC0-1.0");
+    let names: Vec<&str> = bank.positions.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(names, ["edge", "centre"]);
+    for (m, f) in bank.modes.iter().zip([440.0, 1234.5]) {
+        assert!(
+            (m.freq_hz / f - 1.0).abs() < 1e-4,
+            "{} Hz vs {f} Hz",
+            m.freq_hz
+        );
+    }
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("report.json")).unwrap())
+            .unwrap();
+    assert_eq!(report["recordings"][1]["name"], "centre");
+    assert!(
+        report["recordings"][0]["lsd_db"].as_f64().unwrap() < 3.0,
+        "{report}"
+    );
+    assert_eq!(report["modes"].as_array().unwrap().len(), 2);
+}
+
+#[test]
+fn fit_rejects_bad_recordings_and_writes_nothing() {
+    let dir = dir_with_bank();
+    std::fs::write(dir.path().join("notes.wav"), "these are words, not sound").unwrap();
+    let out = run(dir.path(), &["fit", "notes.wav", "-o", "out.json"]);
+    assert_failed_cleanly(
+        &out,
+        &["notes.wav", "not a WAV file"],
+        dir.path(),
+        &["notes.wav"],
+    );
+
+    write_strike_wav(&dir.path().join("surround.wav"), 3);
+    let out = run(dir.path(), &["fit", "surround.wav", "-o", "out.json"]);
+    assert_failed_cleanly(
+        &out,
+        &["surround.wav", "3 channels", "mono or stereo"],
+        dir.path(),
+        &["notes.wav", "surround.wav"],
+    );
+
+    let out = run(dir.path(), &["fit", "missing.wav", "-o", "out.json"]);
+    assert_failed_cleanly(
+        &out,
+        &["missing.wav", "cannot read"],
+        dir.path(),
+        &["notes.wav", "surround.wav"],
+    );
+
+    // Silence: a valid WAV file with nothing in it.
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: 44_100,
+        bits_per_sample: 16,
+        sample_format: hound::SampleFormat::Int,
+    };
+    let mut writer = hound::WavWriter::create(dir.path().join("silence.wav"), spec).unwrap();
+    for _ in 0..44_100 {
+        writer.write_sample(0i16).unwrap();
+    }
+    writer.finalize().unwrap();
+    let out = run(dir.path(), &["fit", "silence.wav=top", "-o", "out.json"]);
+    assert_failed_cleanly(
+        &out,
+        &["top", "no strike found", "every sample is zero"],
+        dir.path(),
+        &["notes.wav", "silence.wav", "surround.wav"],
+    );
+
+    let out = run(
+        dir.path(),
+        &[
+            "fit",
+            "silence.wav",
+            "-o",
+            "out.json",
+            "--noise-floor-db",
+            "6",
+        ],
+    );
+    assert_failed_cleanly(
+        &out,
+        &["--noise-floor-db 6"],
+        dir.path(),
+        &["notes.wav", "silence.wav", "surround.wav"],
+    );
+}
+
+#[test]
+fn shape_builds_a_stated_steel_bar_and_prints_its_summary() {
+    let dir = dir_with_bank();
+    let out = run(
+        dir.path(),
+        &[
+            "shape",
+            "free-free-bar",
+            "--material",
+            "steel",
+            "--length",
+            "0.3",
+            "--width",
+            "0.03",
+            "--thickness",
+            "0.01",
+            "-o",
+            "bar.json",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    // f1 = (4.730^2 / (2 pi 0.3^2)) 0.01 sqrt(200e9 / (12 * 7850)) = 576.50 Hz.
+    assert!(text.contains("root 576.50 Hz"), "{text}");
+    // Modes below 20 kHz: b_n L up to (2 * 8 + 1) pi / 2, at 18.37 kHz.
+    assert!(text.contains("bar.json: 8 modes, 4 positions"), "{text}");
+    let bank = modal_resonator::model::load_bank_file(&dir.path().join("bar.json")).unwrap();
+    assert_eq!(bank.modes.len(), 8);
+    assert_eq!(bank.license, "CC0-1.0");
+    let ratio = bank.modes[1].freq_hz / bank.modes[0].freq_hz;
+    assert!((ratio - 2.756).abs() < 1e-3, "ratio {ratio}");
+}
+
+#[test]
+fn shape_tunes_takes_positions_and_limits() {
+    let dir = dir_with_bank();
+    let out = run(
+        dir.path(),
+        &[
+            "shape",
+            "circular-plate",
+            "--edge",
+            "clamped",
+            "--material",
+            "ceramic",
+            "--root-note",
+            "A4",
+            "--positions",
+            "centre=0,0; rim side=0.8,0.3",
+            "--modes",
+            "20",
+            "--name",
+            "Test disc",
+            "-o",
+            "disc.json",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let bank = modal_resonator::model::load_bank_file(&dir.path().join("disc.json")).unwrap();
+    assert_eq!(bank.name, "Test disc");
+    assert!((bank.root_hz.unwrap() - 440.0).abs() < 1e-9);
+    assert_eq!(bank.modes.len(), 20);
+    assert_eq!(bank.positions.len(), 2);
+    let source = bank.source.unwrap();
+    assert_eq!(
+        (source["material"].as_str(), source["edge"].as_str()),
+        (Some("porcelain"), Some("clamped"))
+    );
+    let tuned = run(
+        dir.path(),
+        &[
+            "shape",
+            "stiff-string",
+            "--tune-hz",
+            "110",
+            "-o",
+            "string.json",
+        ],
+    );
+    assert!(tuned.status.success(), "{}", stderr(&tuned));
+    assert!(
+        stdout(&tuned).contains("root 110.00 Hz (A2)"),
+        "{}",
+        stdout(&tuned)
+    );
+}
+
+#[test]
+fn shape_refuses_bad_names_and_dimensions_cleanly() {
+    let dir = dir_with_bank();
+    let out = run(dir.path(), &["shape", "kazoo", "-o", "x.json"]);
+    assert_failed_cleanly(
+        &out,
+        &[
+            "unknown object \"kazoo\"",
+            "expected one of ideal-string",
+            "circular-plate",
+        ],
+        dir.path(),
+        &[],
+    );
+    let out = run(
+        dir.path(),
+        &["shape", "bell", "--material", "cheese", "-o", "x.json"],
+    );
+    assert_failed_cleanly(
+        &out,
+        &[
+            "unknown material \"cheese\"",
+            "steel",
+            "porcelain (ceramic)",
+        ],
+        dir.path(),
+        &[],
+    );
+    let out = run(
+        dir.path(),
+        &["shape", "free-free-bar", "--radius", "0.1", "-o", "x.json"],
+    );
+    assert_failed_cleanly(
+        &out,
+        &["free-free-bar does not take it", "--length"],
+        dir.path(),
+        &[],
+    );
+    let out = run(
+        dir.path(),
+        &[
+            "shape",
+            "free-free-bar",
+            "--thickness",
+            "-1",
+            "-o",
+            "x.json",
+        ],
+    );
+    assert_failed_cleanly(&out, &["expected a number above 0"], dir.path(), &[]);
+    let out = run(
+        dir.path(),
+        &[
+            "shape",
+            "ideal-string",
+            "--positions",
+            "1.5",
+            "-o",
+            "x.json",
+        ],
+    );
+    assert_failed_cleanly(&out, &["positions[0]", "[0, 1]"], dir.path(), &[]);
+    let help = run(dir.path(), &["shape", "--help"]);
+    let text = stdout(&help);
+    for word in [
+        "clamped-free-bar",
+        "rectangular-membrane",
+        "acrylic",
+        "hardwood",
+    ] {
+        assert!(text.contains(word), "shape --help lacks {word}: {text}");
+    }
+}
+
+#[test]
+fn compress_merges_and_drops_and_reports() {
+    let dir = tempfile::tempdir().unwrap();
+    // 2000 and 2002 Hz are within the 5 Hz limen; the 3 kHz mode is 100 dB down.
+    let mut bank = common::simple_bank(&[
+        (2000.0, 4.0, 1.0),
+        (2002.0, 4.0, 0.5),
+        (2500.0, 5.0, 0.3),
+        (3000.0, 6.0, 1e-5),
+    ]);
+    bank.root_hz = Some(2000.0);
+    modal_resonator::model::save_bank_file(&bank, &dir.path().join("bank.json")).unwrap();
+    let out = run(dir.path(), &["compress", "bank.json", "-o", "small.json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("4 modes -> 2 modes (merged 1, dropped 1)"),
+        "{}",
+        stdout(&out)
+    );
+    let small = modal_resonator::model::load_bank_file(&dir.path().join("small.json")).unwrap();
+    assert_eq!(small.modes.len(), 2);
+    assert!((small.modes[0].gains[0] - 1.5).abs() < 1e-12);
+    let kept = run(
+        dir.path(),
+        &[
+            "compress",
+            "bank.json",
+            "-o",
+            "kept.json",
+            "--keep-weak",
+            "--limen-scale",
+            "0",
+        ],
+    );
+    assert!(
+        stdout(&kept).contains("4 modes -> 4 modes (merged 0, dropped 0)"),
+        "{}",
+        stdout(&kept)
+    );
+    // Factory banks by name; the input is never overwritten.
+    let plate = run(dir.path(), &["compress", "steel-plate", "-o", "plate.json"]);
+    assert!(plate.status.success(), "{}", stderr(&plate));
+    assert!(
+        stdout(&plate).starts_with("300 modes -> "),
+        "{}",
+        stdout(&plate)
+    );
+    let same = run(dir.path(), &["compress", "bank.json", "-o", "bank.json"]);
+    assert!(!same.status.success());
+    assert!(stderr(&same).contains("overwrite"), "{}", stderr(&same));
+    let bad = run(
+        dir.path(),
+        &[
+            "compress",
+            "bank.json",
+            "-o",
+            "x.json",
+            "--drop-below-db",
+            "6",
+        ],
+    );
+    assert!(!bad.status.success());
+    assert!(
+        stderr(&bad).contains("drop_below_db = 6"),
+        "{}",
+        stderr(&bad)
+    );
+    assert!(!dir.path().join("x.json").exists());
 }

@@ -1,11 +1,16 @@
-//! The committed factory presets match what `src/model/factory.rs` generates.
+//! The committed factory presets match what `src/model/factory/` generates, and every factory
+//! bank, analytic or fitted, validates and plays: non-silent, finite, and peaking near -6 dBFS
+//! when struck at full velocity on its root key with its own defaults.
 //!
 //! `UPDATE_PRESETS=1 cargo test factory_presets` rewrites `presets/<slug>.json` and the factory
-//! table in `presets/README.md` instead of checking them.
+//! table in `presets/README.md` instead of checking them. (The fitted banks in `presets/fitted/`
+//! are rewritten by `tests/fit_recordings.rs`.)
+
+mod common;
 
 use modal_resonator::model::factory::{
-    factory_banks, factory_slug, factory_table_markdown, first_difference, splice_factory_table,
-    write_factory_presets, FACTORY_TABLE_FILE,
+    analytic_factory_banks, factory_banks, factory_slug, factory_table_markdown, first_difference,
+    splice_factory_table, write_factory_presets, FACTORY_TABLE_FILE,
 };
 use modal_resonator::model::Bank;
 use std::path::PathBuf;
@@ -27,8 +32,8 @@ fn updating() -> bool {
 #[test]
 fn factory_presets_are_up_to_date() {
     let dir = presets_dir();
-    let banks = factory_banks();
-    let table = factory_table_markdown(&banks);
+    let table = factory_table_markdown(&factory_banks());
+    let banks = analytic_factory_banks();
     if updating() {
         let paths = write_factory_presets(&dir).expect("writing the factory presets");
         let readme_path = dir.join(FACTORY_TABLE_FILE);
@@ -74,4 +79,45 @@ fn factory_presets_are_up_to_date() {
         "factory presets are out of date ({HOW_TO_UPDATE}):\n{}",
         stale.join("\n")
     );
+}
+
+/// How far from -6 dBFS a full-velocity strike on the root key may peak, in dB: the engine
+/// normalises each bank to -6 dBFS at its first position; the strike position a bank's defaults
+/// choose, and the nearest key for a root between keys, move the peak a little.
+const PEAK_TOLERANCE_DB: f32 = 1.5;
+
+#[test]
+fn every_factory_bank_validates_and_plays_near_minus_6_dbfs_at_its_root() {
+    use modal_resonator::dsp::coeffs::{gain_to_db, hz_to_midi_key};
+    use modal_resonator::model::validate::validate_bank;
+
+    let rate = 48_000.0;
+    let banks = factory_banks();
+    assert!(banks.len() >= 24, "{} factory banks", banks.len());
+    let mut report = Vec::new();
+    for bank in &banks {
+        let what = &bank.name;
+        assert!(
+            validate_bank(bank).is_empty(),
+            "{what}: {:?}",
+            validate_bank(bank)
+        );
+        let key = hz_to_midi_key(bank.effective_root_hz()).round() as u8;
+        let mut e = common::engine(bank, rate);
+        let (l, r) = common::render(&mut e, &[common::on(0, key, 1.0)], 0.5, 512);
+        assert!(
+            l.iter().chain(&r).all(|v| v.is_finite()),
+            "{what}: not finite"
+        );
+        let peak_db = gain_to_db(common::peak(&l).max(common::peak(&r)));
+        report.push(format!("{what}: {peak_db:.2} dBFS"));
+        assert!(
+            (peak_db + 6.0).abs() <= PEAK_TOLERANCE_DB,
+            "{what}: peak {peak_db:.2} dBFS on key {key}, expected -6 +- {PEAK_TOLERANCE_DB}"
+        );
+        // Still sounding a tenth of a second in: a ring, not a click.
+        let tail = common::peak(&l[4800..9600]).max(common::peak(&r[4800..9600]));
+        assert!(tail > 1e-3, "{what}: silent after 0.1 s ({tail})");
+    }
+    println!("{}", report.join("\n"));
 }

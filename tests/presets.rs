@@ -9,10 +9,12 @@ use modal_resonator::dsp::coeffs::hz_to_midi_key;
 use modal_resonator::model::io::{bank_to_json, load_bank_file, parse_bank_str};
 use modal_resonator::model::validate::validate_bank;
 
+/// The banks in `presets/` and in `presets/fitted/` (banks fitted to recordings).
 fn preset_files() -> Vec<PathBuf> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("presets");
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
+    let mut files: Vec<PathBuf> = [dir.clone(), dir.join("fitted")]
+        .iter()
+        .flat_map(|d| std::fs::read_dir(d).unwrap())
         .map(|e| e.unwrap().path())
         .filter(|p| {
             p.extension().is_some_and(|e| e == "json")

@@ -419,6 +419,15 @@ impl ResonatorBank {
         computed + dormant
     }
 
+    /// Each live mode with its squared amplitude `|z|^2`, in slot order. For meters: it reads the
+    /// state and changes nothing.
+    pub fn live_energies(&self) -> impl Iterator<Item = (usize, f32)> + '_ {
+        self.live_slots().map(|s| {
+            let mode = self.mode_of_slot[s] as usize;
+            (mode, self.re[s] * self.re[s] + self.im[s] * self.im[s])
+        })
+    }
+
     /// Silences every mode.
     pub fn clear(&mut self) {
         for slot in self.live_slots() {

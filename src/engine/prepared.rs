@@ -85,6 +85,14 @@ impl PreparedBank {
         prepared
     }
 
+    /// The order in which a prepared bank holds `bank`'s modes: `frequency_order(bank)[m]` is the
+    /// index in `bank.modes` of prepared mode `m` (ascending frequency, ties in bank order).
+    pub fn frequency_order(bank: &Bank) -> Vec<usize> {
+        let mut order: Vec<usize> = (0..bank.modes.len()).collect();
+        order.sort_by(|&a, &b| bank.modes[a].freq_hz.total_cmp(&bank.modes[b].freq_hz));
+        order
+    }
+
     /// Number of modes.
     pub fn num_modes(&self) -> usize {
         self.freq_hz.len()

@@ -13,6 +13,10 @@
 //! sheets). Loss factors are order-of-magnitude figures: they vary with alloy, grain, temperature
 //! and frequency by a factor of two or more, so the values below sit inside the published ranges
 //! and were chosen so that the objects ring for musically plausible times (see the tests).
+//!
+//! The families of the analytic objects each have a representative, also found by the family's
+//! name: porcelain for the ceramics ("ceramic"), rosewood for the hard woods ("hardwood"),
+//! spruce for the soft woods ("softwood").
 
 /// Decay rate in 1/s added to every mode, whatever its frequency.
 ///
@@ -42,6 +46,9 @@ pub struct Material {
     pub name: &'static str,
     /// Name for people, e.g. "Rosewood".
     pub display_name: &'static str,
+    /// Other names it is found by: the family it stands for ("ceramic", "hardwood") or
+    /// another spelling ("aluminum"). Lowercase ASCII.
+    pub aliases: &'static [&'static str],
     /// Family of the material, for defaults.
     pub class: MaterialClass,
     /// Density in kg/m^3.
@@ -60,6 +67,7 @@ pub struct Material {
 pub const STEEL: Material = Material {
     name: "steel",
     display_name: "Steel",
+    aliases: &[],
     class: MaterialClass::Metal,
     density_kg_m3: 7850.0,
     youngs_modulus_pa: 200e9,
@@ -72,6 +80,7 @@ pub const STEEL: Material = Material {
 pub const ALUMINIUM: Material = Material {
     name: "aluminium",
     display_name: "Aluminium",
+    aliases: &["aluminum"],
     class: MaterialClass::Metal,
     density_kg_m3: 2700.0,
     youngs_modulus_pa: 70e9,
@@ -84,6 +93,7 @@ pub const ALUMINIUM: Material = Material {
 pub const BRASS: Material = Material {
     name: "brass",
     display_name: "Brass",
+    aliases: &[],
     class: MaterialClass::Metal,
     density_kg_m3: 8500.0,
     youngs_modulus_pa: 100e9,
@@ -97,6 +107,7 @@ pub const BRASS: Material = Material {
 pub const BRONZE: Material = Material {
     name: "bronze",
     display_name: "Bell bronze",
+    aliases: &["bell-bronze"],
     class: MaterialClass::Metal,
     density_kg_m3: 8700.0,
     youngs_modulus_pa: 105e9,
@@ -109,6 +120,7 @@ pub const BRONZE: Material = Material {
 pub const GLASS: Material = Material {
     name: "glass",
     display_name: "Glass",
+    aliases: &[],
     class: MaterialClass::GlassCeramic,
     density_kg_m3: 2500.0,
     youngs_modulus_pa: 70e9,
@@ -122,6 +134,7 @@ pub const GLASS: Material = Material {
 pub const PORCELAIN: Material = Material {
     name: "porcelain",
     display_name: "Porcelain",
+    aliases: &["ceramic"],
     class: MaterialClass::GlassCeramic,
     density_kg_m3: 2400.0,
     youngs_modulus_pa: 80e9,
@@ -136,6 +149,7 @@ pub const PORCELAIN: Material = Material {
 pub const ROSEWOOD: Material = Material {
     name: "rosewood",
     display_name: "Rosewood",
+    aliases: &["hardwood", "hard-wood"],
     class: MaterialClass::Wood,
     density_kg_m3: 1000.0,
     youngs_modulus_pa: 18e9,
@@ -149,6 +163,7 @@ pub const ROSEWOOD: Material = Material {
 pub const SPRUCE: Material = Material {
     name: "spruce",
     display_name: "Spruce",
+    aliases: &["softwood", "soft-wood"],
     class: MaterialClass::Wood,
     density_kg_m3: 450.0,
     youngs_modulus_pa: 11e9,
@@ -162,6 +177,7 @@ pub const SPRUCE: Material = Material {
 pub const ACRYLIC: Material = Material {
     name: "acrylic",
     display_name: "Acrylic",
+    aliases: &["pmma", "plexiglas"],
     class: MaterialClass::Polymer,
     density_kg_m3: 1190.0,
     youngs_modulus_pa: 3.2e9,
@@ -176,6 +192,7 @@ pub const ACRYLIC: Material = Material {
 pub const MYLAR: Material = Material {
     name: "mylar",
     display_name: "Mylar (polyester film)",
+    aliases: &["polyester", "pet"],
     class: MaterialClass::Polymer,
     density_kg_m3: 1390.0,
     youngs_modulus_pa: 4.5e9,
@@ -189,13 +206,40 @@ pub const MATERIALS: &[Material] = &[
 ];
 
 impl Material {
-    /// The material called `name` (its identifier or display name, any case).
+    /// The material called `name`: its identifier, display name or one of its aliases, in any
+    /// case, with spaces or underscores taken for hyphens ("hard wood" finds rosewood).
     pub fn by_name(name: &str) -> Option<&'static Material> {
         let name = name.trim();
+        let hyphenated = name.replace([' ', '_'], "-");
         MATERIALS.iter().find(|material| {
             material.name.eq_ignore_ascii_case(name)
                 || material.display_name.eq_ignore_ascii_case(name)
+                || material
+                    .aliases
+                    .iter()
+                    .any(|alias| alias.eq_ignore_ascii_case(&hyphenated))
         })
+    }
+
+    /// Every material's identifier with its aliases, e.g. "porcelain (ceramic)", for listings
+    /// and error messages.
+    pub fn names_with_aliases() -> Vec<String> {
+        MATERIALS
+            .iter()
+            .map(|material| {
+                let aliases: Vec<&str> = material
+                    .aliases
+                    .iter()
+                    .copied()
+                    .filter(|alias| !alias.contains('-'))
+                    .collect();
+                if aliases.is_empty() {
+                    material.name.to_string()
+                } else {
+                    format!("{} ({})", material.name, aliases.join(", "))
+                }
+            })
+            .collect()
     }
 
     /// Quality factor `Q = 1 / tan(phi)` of the internal friction alone.
@@ -233,8 +277,29 @@ mod tests {
                 assert_ne!(material.name, other.name);
             }
             assert!(material.name.bytes().all(|b| b.is_ascii_lowercase()));
+            for alias in material.aliases {
+                assert_eq!(Material::by_name(alias), Some(material), "{alias}");
+                let others = MATERIALS.iter().filter(|m| m.name != material.name);
+                for other in others {
+                    assert!(!other.aliases.contains(alias) && other.name != *alias);
+                }
+            }
         }
         assert_eq!(Material::by_name("unobtainium"), None);
+        // The families the analytic objects are asked for by.
+        assert_eq!(Material::by_name("ceramic"), Some(&PORCELAIN));
+        assert_eq!(Material::by_name("Hard wood"), Some(&ROSEWOOD));
+        assert_eq!(Material::by_name("soft_wood"), Some(&SPRUCE));
+        assert_eq!(Material::by_name("aluminum"), Some(&ALUMINIUM));
+        let listed = Material::names_with_aliases();
+        assert!(
+            listed.contains(&"porcelain (ceramic)".to_string()),
+            "{listed:?}"
+        );
+        assert!(
+            listed.contains(&"rosewood (hardwood)".to_string()),
+            "{listed:?}"
+        );
     }
 
     #[test]

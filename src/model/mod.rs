@@ -3,8 +3,11 @@
 //! Nothing here runs on the audio thread: code in this module may allocate and may fail.
 
 pub mod bank;
+pub mod compress;
 pub mod factory;
+pub mod fit;
 pub mod io;
+pub mod limen;
 pub mod materials;
 pub mod schema;
 pub mod shapes;

@@ -27,6 +27,36 @@ pub fn note_name(freq_hz: f64) -> String {
     }
 }
 
+/// The MIDI key (60 = C4, 69 = A4) of a note name such as "C4", "F#2", "Bb5" or "C-1", or of a
+/// key number such as "60"; `None` when `text` is neither.
+pub fn note_to_midi_key(text: &str) -> Option<u8> {
+    let text = text.trim();
+    if let Ok(key) = text.parse::<u8>() {
+        return (key <= 127).then_some(key);
+    }
+    let mut chars = text.chars();
+    let letter = chars.next()?.to_ascii_uppercase();
+    let pitch_class: i32 = match letter {
+        'C' => 0,
+        'D' => 2,
+        'E' => 4,
+        'F' => 5,
+        'G' => 7,
+        'A' => 9,
+        'B' => 11,
+        _ => return None,
+    };
+    let rest = chars.as_str();
+    let (accidental, octave) = match rest.chars().next()? {
+        '#' => (1, &rest[1..]),
+        'b' => (-1, &rest[1..]),
+        _ => (0, rest),
+    };
+    let octave: i32 = octave.parse().ok()?;
+    let key = 12 * (octave + 1) + pitch_class + accidental;
+    u8::try_from(key).ok().filter(|&k| k <= 127)
+}
+
 /// The facts about a bank worth showing.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BankSummary {
@@ -175,6 +205,25 @@ impl fmt::Display for BankSummary {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn note_names_parse_to_keys() {
+        assert_eq!(note_to_midi_key("C4"), Some(60));
+        assert_eq!(note_to_midi_key("a4"), Some(69));
+        assert_eq!(note_to_midi_key("F#2"), Some(42));
+        assert_eq!(note_to_midi_key("Bb5"), Some(82));
+        assert_eq!(note_to_midi_key("C-1"), Some(0));
+        assert_eq!(note_to_midi_key("G9"), Some(127));
+        assert_eq!(note_to_midi_key(" 61 "), Some(61));
+        for bad in ["", "H2", "C", "C#", "G#9", "128", "Cb-1", "C4x"] {
+            assert_eq!(note_to_midi_key(bad), None, "{bad}");
+        }
+        // note_name reads back.
+        for key in 0..=127u8 {
+            let hz = crate::dsp::coeffs::midi_key_to_hz(f64::from(key));
+            assert_eq!(note_to_midi_key(&note_name(hz)), Some(key));
+        }
+    }
 
     #[test]
     fn note_names_and_cents() {

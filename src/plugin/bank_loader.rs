@@ -13,6 +13,8 @@ pub const DEFAULT_FACTORY_BANK: &str = "rosewood-marimba-bar";
 pub struct LoadedEngine {
     /// Which version of the saved bank it was built from.
     pub generation: u64,
+    /// The activation it was asked for in.
+    pub epoch: u64,
     /// The engine, prepared for the current sample rate.
     pub engine: Box<Engine>,
 }

@@ -6,6 +6,7 @@ use nice_plug::midi::{Channel, Key, VoiceID};
 use nice_plug::prelude::*;
 
 use super::{Kind, ModalPlugin, MAX_EVENTS};
+use crate::editor::Audition;
 use crate::engine::{Note, NoteEvent as EngineEvent, NoteExpression};
 use crate::params::ExpressionTarget;
 
@@ -80,6 +81,7 @@ impl<K: Kind> ModalPlugin<K> {
         let mpe_range = self.params.mpe_bend_range.value();
         let pressure_damps = self.params.pressure_target.value() == ExpressionTarget::Damping;
         let is_member = |channel: u8| mpe && channel != MPE_MANAGER_CHANNEL;
+        self.read_auditions();
         while let Some(event) = context.next_event() {
             match event {
                 NoteEvent::NoteOn {
@@ -156,13 +158,15 @@ impl<K: Kind> ModalPlugin<K> {
                         });
                     }
                 }
+                // Per-note pressure follows the pressure routing: it can damp one note; a strike
+                // position only matters when the note is struck, so it is not moved per note.
                 NoteEvent::PolyPressure {
                     timing,
                     voice_id,
                     channel,
                     key,
                     pressure,
-                } => {
+                } if pressure_damps => {
                     if let Some(note) = note_of(voice_id, channel, key) {
                         self.push(EngineEvent::Expression {
                             time: timing,
@@ -263,6 +267,34 @@ impl<K: Kind> ModalPlugin<K> {
                     _ => {}
                 },
                 _ => {}
+            }
+        }
+    }
+
+    /// Turns the editor's strike-pad requests into notes at the block's start: a strike on the
+    /// last key played (else the bank's root) at the pad's position, and its release.
+    fn read_auditions(&mut self) {
+        while let Some(audition) = self.editor_shared.next_audition() {
+            let key = match audition {
+                Audition::Strike { .. } => {
+                    let root = self
+                        .engines
+                        .current
+                        .as_ref()
+                        .map_or(60.0, |e| e.bank().root_key);
+                    let key = self
+                        .last_key
+                        .unwrap_or(root.round().clamp(0.0, 127.0) as u8);
+                    self.audition_key = Some(key);
+                    key
+                }
+                Audition::Release => match self.audition_key.take() {
+                    Some(key) => key,
+                    None => continue,
+                },
+            };
+            for event in audition.events(key) {
+                self.push(event);
             }
         }
     }

@@ -2,24 +2,28 @@
 //! does the rest. The instrument and the effect share everything but their [`Kind`].
 
 mod bank_loader;
+mod engines;
 mod events;
 mod kind;
 mod poly;
 
 use std::marker::PhantomData;
-use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 use std::sync::{Arc, RwLock};
+use std::time::Instant;
 
-use crossbeam_channel::{Receiver, Sender};
 use nice_plug::midi::{Channel, Key, VoiceID};
 use nice_plug::prelude::*;
+use nice_plug_egui::{EguiEditor, EguiEditorState};
 
 pub use bank_loader::{bank_from_state, build_engine, LoadedEngine, DEFAULT_FACTORY_BANK};
 pub use kind::{Effect, Instrument, Kind};
 
 use crate::dsp::onset::OnsetDetector;
-use crate::engine::{EndedVoice, Engine, NoteEvent as EngineEvent, MAX_POLYPHONY};
-use crate::params::{InputMode, ModalParams};
+use crate::editor::{self, EditorApp, EditorLinks, EditorShared, AUDITION_NOTE_ID};
+use crate::engine::{EndedVoice, NoteEvent as EngineEvent, MAX_POLYPHONY};
+use crate::params::{InputMode, ModalParams, STATE_FORMAT, STATE_FORMAT_FIELD};
+use engines::Engines;
 use events::{ControlChange, Expression};
 use poly::PolyTable;
 
@@ -40,18 +44,11 @@ const BANK_CROSSFADE_S: f32 = 0.05;
 /// Notes whose polyphonic modulation is tracked (the engine's voices, counting those fading).
 const POLY_NOTES: usize = 2 * MAX_POLYPHONY;
 
-/// The engine that was playing before a bank swap, fading out.
-struct Outgoing {
-    /// The engine.
-    engine: Box<Engine>,
-    /// Its gain now, 1 down to 0.
-    gain: f32,
-}
-
 /// Work for the background thread.
 pub enum Task {
-    /// Build an engine for the bank saved in the parameters, at this generation.
-    LoadBank(u64),
+    /// Build an engine for the bank saved in the parameters, at this generation, for this
+    /// activation.
+    LoadBank { generation: u64, epoch: u64 },
     /// Drop the engines the audio thread has handed back.
     CollectGarbage,
 }
@@ -72,26 +69,22 @@ struct Shared {
     max_block: AtomicU32,
     /// The last problem loading a bank, for the editor; the previous bank keeps playing.
     bank_error: RwLock<Option<String>>,
+    /// The last bank generation that failed to load (not asked for again).
+    failed_generation: AtomicU64,
+    /// The JSON of the bank playing, put back in the state when a new one fails to load.
+    playing_json: RwLock<String>,
 }
 
 /// A Modal Resonator plugin of kind `K`.
 pub struct ModalPlugin<K: Kind> {
     /// Host parameters and the saved bank.
     params: Arc<ModalParams>,
-    /// The engine; `None` until activated.
-    engine: Option<Box<Engine>>,
+    /// The engine playing, the one fading out, and those on their way.
+    engines: Engines,
     /// Settings shared with the background thread.
     shared: Arc<Shared>,
-    /// Engines built by the background thread.
-    loaded_tx: Sender<LoadedEngine>,
-    loaded_rx: Receiver<LoadedEngine>,
-    /// Engines the audio thread is done with, dropped by the background thread.
-    trash_tx: Sender<Box<Engine>>,
-    trash_rx: Receiver<Box<Engine>>,
-    /// An old engine waiting for room in the trash.
-    pending_trash: Option<Box<Engine>>,
-    /// The bank generation last asked for.
-    requested_generation: u64,
+    /// The background thread's ends of the engine channels.
+    background: engines::BackgroundEnds,
     /// Note events of the current block, in time order.
     events: Vec<EngineEvent>,
     /// Note events of the part of the block being rendered, timed from its start.
@@ -100,13 +93,11 @@ pub struct ModalPlugin<K: Kind> {
     changes: Vec<(u32, ControlChange)>,
     /// The host's polyphonic modulation offsets, per note id.
     poly: PolyTable,
-    /// The engine that was playing before the last bank swap, while it fades out.
-    outgoing: Option<Outgoing>,
     /// Output of the outgoing engine.
     outgoing_out: [Vec<f32>; 2],
     /// Mono mix of the audio input.
     input: Vec<f32>,
-    /// Dry input of the effect.
+    /// Dry input (the effect's input, or the instrument's exciter input).
     dry: [Vec<f32>; 2],
     /// Onsets of the input in trigger mode.
     onsets: OnsetDetector,
@@ -116,28 +107,27 @@ pub struct ModalPlugin<K: Kind> {
     last_key: Option<u8>,
     /// Dry/wet mix at the end of the last block; `None` after a reset (no ramp needed).
     wet: Option<f32>,
+    /// The editor's size and whether it is open.
+    editor_state: Arc<EguiEditorState>,
+    /// Meters for the editor and its strike pad's requests.
+    editor_shared: Arc<EditorShared>,
+    /// The key of the strike pad's note while it is held.
+    audition_key: Option<u8>,
     _kind: PhantomData<K>,
 }
 
 impl<K: Kind> Default for ModalPlugin<K> {
     fn default() -> Self {
-        let (loaded_tx, loaded_rx) = crossbeam_channel::bounded(4);
-        let (trash_tx, trash_rx) = crossbeam_channel::bounded(4);
+        let (engines, background) = Engines::new();
         Self {
             params: Arc::new(ModalParams::new(K::IS_EFFECT)),
-            engine: None,
+            engines,
             shared: Arc::new(Shared::default()),
-            loaded_tx,
-            loaded_rx,
-            trash_tx,
-            trash_rx,
-            pending_trash: None,
-            requested_generation: 0,
+            background,
             events: Vec::with_capacity(MAX_EVENTS),
             segment_events: Vec::with_capacity(MAX_EVENTS),
             changes: Vec::with_capacity(MAX_EVENTS),
             poly: PolyTable::new(POLY_NOTES),
-            outgoing: None,
             outgoing_out: [Vec::new(), Vec::new()],
             input: Vec::new(),
             dry: [Vec::new(), Vec::new()],
@@ -145,6 +135,9 @@ impl<K: Kind> Default for ModalPlugin<K> {
             expression: Expression::default(),
             last_key: None,
             wet: None,
+            editor_state: editor::default_state(),
+            editor_shared: Arc::new(EditorShared::new()),
+            audition_key: None,
             _kind: PhantomData,
         }
     }
@@ -156,80 +149,16 @@ impl<K: Kind> ModalPlugin<K> {
         self.shared.bank_error.read().ok().and_then(|e| e.clone())
     }
 
-    /// Swaps in an engine the background thread finished, and hands old engines back to it.
-    /// The engine that was playing fades out over [`BANK_CROSSFADE_S`]. Returns whether any
-    /// engine went to the trash (the background thread should drop it).
-    fn take_loaded_engine(&mut self, context: &mut impl ProcessContext<Self>) -> bool {
-        let mut trashed = false;
-        if let Some(old) = self.pending_trash.take() {
-            trashed |= self.discard(old);
-        }
-        if self.pending_trash.is_some() {
-            return trashed;
-        }
-        let rate = f32::from_bits(self.shared.sample_rate_bits.load(Ordering::Acquire));
-        while let Ok(loaded) = self.loaded_rx.try_recv() {
-            // Superseded by a newer request, or built before the host changed the sample rate:
-            // discard it. Otherwise swap it in and let the old one fade out.
-            let current = loaded.generation == self.requested_generation
-                && loaded.engine.sample_rate_hz() == rate;
-            let old = if current {
-                match self.engine.replace(loaded.engine) {
-                    Some(old) if !old.is_silent() => {
-                        // A fade already under way is cut short by the newer swap.
-                        let cut = self.outgoing.replace(Outgoing {
-                            engine: old,
-                            gain: 1.0,
-                        });
-                        cut.map(|o| o.engine)
-                    }
-                    old => old,
-                }
-            } else {
-                Some(loaded.engine)
-            };
-            if let Some(mut old) = old {
-                self.end_engine(&mut old, 0, context);
-                trashed |= self.discard(old);
-                if self.pending_trash.is_some() {
-                    break;
-                }
-            }
-        }
-        trashed
-    }
-
-    /// Silences `engine` for good, telling the host its notes ended at sample `time`.
-    fn end_engine(
-        &mut self,
-        engine: &mut Engine,
-        time: u32,
-        context: &mut impl ProcessContext<Self>,
-    ) {
-        engine.end_all_voices();
-        for ended in engine.take_ended_voices() {
-            report_ended(&mut self.poly, context, EndedVoice { time, ..ended });
-        }
-    }
-
-    /// Hands `engine` to the background thread to be dropped there, or keeps it for later when
-    /// the trash is full. Never drops it here.
-    fn discard(&mut self, engine: Box<Engine>) -> bool {
-        match self.trash_tx.try_send(engine) {
-            Ok(()) => true,
-            Err(e) => {
-                self.pending_trash = Some(e.into_inner());
-                false
-            }
-        }
-    }
-
     /// Adds a strike at each onset of `self.input[..n]` (trigger mode) to the segment's events,
     /// keeping them in time order.
     fn add_onsets(&mut self, n: usize) {
         let threshold = util::db_to_gain(self.params.trigger_threshold.value());
         let retrigger_s = self.params.retrigger.value() * 1e-3;
-        let root = self.engine.as_ref().map_or(60.0, |e| e.bank().root_key);
+        let root = self
+            .engines
+            .current
+            .as_ref()
+            .map_or(60.0, |e| e.bank().root_key);
         let key = self
             .last_key
             .unwrap_or(root.round().clamp(0.0, 127.0) as u8);
@@ -268,6 +197,9 @@ impl<K: Kind> ModalPlugin<K> {
             have_input = true;
         } else if let Some(ex) = exciter {
             if ex.len() >= 2 && ex[0].len() >= end && ex[1].len() >= end {
+                for (dry, channel) in self.dry.iter_mut().zip(ex.iter()) {
+                    dry[..n].copy_from_slice(&channel[start..end]);
+                }
                 mix_to_mono(&ex[0][start..end], &ex[1][start..end], &mut self.input[..n]);
                 have_input = true;
             }
@@ -281,7 +213,7 @@ impl<K: Kind> ModalPlugin<K> {
         let controls = self.params.controls(e.bend, e.mod_wheel, e.pressure);
         let (left, rest) = channels.split_at_mut(1);
         let (out_l, out_r) = (&mut left[0][start..end], &mut rest[0][start..end]);
-        let Some(engine) = self.engine.as_mut() else {
+        let Some(engine) = self.engines.current.as_mut() else {
             return;
         };
         engine.set_controls(&controls);
@@ -291,7 +223,7 @@ impl<K: Kind> ModalPlugin<K> {
             report_ended(&mut self.poly, context, EndedVoice { time, ..ended });
         }
 
-        if let Some(outgoing) = self.outgoing.as_mut() {
+        if let Some(outgoing) = self.engines.outgoing.as_mut() {
             let [ol, or] = &mut self.outgoing_out;
             let (ol, or) = (&mut ol[..n], &mut or[..n]);
             outgoing.engine.set_controls(&controls);
@@ -307,16 +239,20 @@ impl<K: Kind> ModalPlugin<K> {
                 *l += outgoing.gain * a;
                 *r += outgoing.gain * b;
             }
+            // Nothing to tell the host: its notes were reported ended at the swap.
+            let _ = outgoing.engine.take_ended_voices().count();
             if outgoing.gain <= 0.0 || outgoing.engine.is_silent() {
-                let mut done = self.outgoing.take().expect("checked above").engine;
-                self.end_engine(&mut done, (end - 1) as u32, context);
-                if self.discard(done) {
+                let mut done = self.engines.outgoing.take().expect("checked above").engine;
+                done.end_all_voices();
+                let _ = done.take_ended_voices().count();
+                if self.engines.discard(done) {
                     context.execute_background(Task::CollectGarbage);
                 }
             }
         }
 
-        if K::IS_EFFECT {
+        // Dry/wet: the effect's input, or the instrument's exciter input when it has one.
+        if have_input {
             // Ramp from the last segment's mix to this one's, so automation does not zipper.
             let to = self.params.dry_wet.value();
             let from = self.wet.unwrap_or(to);
@@ -342,6 +278,10 @@ fn report_ended<P: Plugin>(
     if let Some(id) = ended.note.id {
         poly.remove(id);
     }
+    // The editor's strike pad auditions are the plugin's own notes: the host never saw them.
+    if ended.note.id == Some(AUDITION_NOTE_ID) {
+        return;
+    }
     // Hosts without an output event list (or with a full one) do not need to know.
     let _ = context.try_send_event(NoteEvent::VoiceTerminated {
         timing: ended.time,
@@ -361,7 +301,7 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
     const MIDI_INPUT: MidiConfig = MidiConfig::MidiCCs;
     const SAMPLE_ACCURATE_AUTOMATION: bool = false;
 
-    type Editor = ();
+    type Editor = EguiEditor<EditorApp>;
     type SysExMessage = ();
     type BackgroundTask = Task;
 
@@ -369,41 +309,70 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         self.params.clone()
     }
 
+    fn editor(&mut self, _async_executor: AsyncExecutor<Self>) -> Option<Self::Editor> {
+        let shared = self.shared.clone();
+        let app = EditorApp::new(EditorLinks {
+            params: self.params.clone(),
+            shared: self.editor_shared.clone(),
+            bank_error: Arc::new(move || shared.bank_error.read().ok().and_then(|e| e.clone())),
+            is_effect: K::IS_EFFECT,
+        });
+        editor::create(K::NAME, self.editor_state.clone(), app)
+    }
+
     fn task_executor(&mut self) -> TaskExecutor<Self> {
         let params = self.params.clone();
         let shared = self.shared.clone();
-        let loaded_tx = self.loaded_tx.clone();
-        let trash_rx = self.trash_rx.clone();
+        let loaded_tx = self.background.loaded_tx.clone();
+        let trash_rx = self.background.trash_rx.clone();
         Box::new(move |task| {
             // Engines the audio thread is done with are dropped here, off the audio thread.
             while trash_rx.try_recv().is_ok() {}
-            match task {
-                Task::CollectGarbage => {}
-                Task::LoadBank(generation) => {
-                    // A newer bank is already on its way: building this one would be wasted.
-                    if params.bank.generation.load(Ordering::Acquire) != generation {
-                        return;
+            let Task::LoadBank { generation, epoch } = task else {
+                return;
+            };
+            // A newer bank is already on its way: building this one would be wasted.
+            if params.bank.generation.load(Ordering::Acquire) != generation {
+                return;
+            }
+            let json = params
+                .bank
+                .json
+                .read()
+                .map(|j| j.clone())
+                .unwrap_or_default();
+            match bank_from_state(&json) {
+                Ok(bank) => {
+                    let rate = f32::from_bits(shared.sample_rate_bits.load(Ordering::Acquire));
+                    let max_block = shared.max_block.load(Ordering::Acquire) as usize;
+                    let engine = build_engine(&bank, rate, max_block);
+                    set_error(&shared, None);
+                    if let Ok(mut playing) = shared.playing_json.write() {
+                        *playing = json;
                     }
-                    let json = params
-                        .bank
-                        .json
-                        .read()
-                        .map(|j| j.clone())
-                        .unwrap_or_default();
-                    match bank_from_state(&json) {
-                        Ok(bank) => {
-                            let rate =
-                                f32::from_bits(shared.sample_rate_bits.load(Ordering::Acquire));
-                            let max_block = shared.max_block.load(Ordering::Acquire) as usize;
-                            let engine = build_engine(&bank, rate, max_block);
-                            set_error(&shared, None);
-                            let _ = loaded_tx.try_send(LoadedEngine { generation, engine });
-                        }
-                        Err(message) => set_error(&shared, Some(message)),
+                    // A full queue drops it; the audio thread asks again.
+                    let _ = loaded_tx.try_send(LoadedEngine {
+                        generation,
+                        epoch,
+                        engine,
+                    });
+                }
+                Err(message) => {
+                    set_error(&shared, Some(message));
+                    shared
+                        .failed_generation
+                        .store(generation, Ordering::Release);
+                    // The state keeps the bank that is heard, not the broken text.
+                    if let Ok(playing) = shared.playing_json.read() {
+                        params.bank.restore(generation, &playing);
                     }
                 }
             }
         })
+    }
+
+    fn filter_state(state: &mut PluginState) {
+        migrate_state(state);
     }
 
     fn activate(
@@ -426,11 +395,10 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         self.input = vec![0.0; max_block];
         self.dry = [vec![0.0; max_block], vec![0.0; max_block]];
         self.outgoing_out = [vec![0.0; max_block], vec![0.0; max_block]];
-        self.outgoing = None;
         self.poly.clear();
         self.onsets = OnsetDetector::new(rate);
         // Build the engine here, synchronously, so offline renders start with the right bank.
-        self.requested_generation = self.params.bank.generation.load(Ordering::Acquire);
+        let generation = self.params.bank.generation.load(Ordering::Acquire);
         let json = self
             .params
             .bank
@@ -441,39 +409,48 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         let bank = match bank_from_state(&json) {
             Ok(bank) => {
                 set_error(&self.shared, None);
+                if let Ok(mut playing) = self.shared.playing_json.write() {
+                    *playing = json;
+                }
                 bank
             }
             Err(message) => {
                 set_error(&self.shared, Some(message));
-                // Keep the bank that was playing; the factory default only on a first start.
-                match self.engine.as_ref() {
+                // Keep the bank that was playing (in the state too); the factory default only
+                // on a first start.
+                let playing = self
+                    .shared
+                    .playing_json
+                    .read()
+                    .map(|j| j.clone())
+                    .unwrap_or_default();
+                self.params.bank.restore(generation, &playing);
+                match self.engines.current.as_ref() {
                     Some(engine) => engine.bank().source.clone(),
-                    None => match bank_from_state("") {
+                    None => match bank_from_state(&playing) {
                         Ok(bank) => bank,
                         Err(_) => return false,
                     },
                 }
             }
         };
-        self.engine = Some(build_engine(&bank, rate, max_block));
-        // Nothing queued for an older setting may replace it.
-        while let Ok(stale) = self.loaded_rx.try_recv() {
-            drop(stale);
-        }
+        let mut engine = build_engine(&bank, rate, max_block);
+        engine.set_last_key(self.last_key);
+        self.engines.activate(engine, generation);
         true
     }
 
     fn reset(&mut self) {
-        if let Some(engine) = self.engine.as_mut() {
+        if let Some(engine) = self.engines.current.as_mut() {
             engine.reset();
         }
         self.onsets.reset();
         self.wet = None;
-        // A reset ends every note at once, for the host as well.
-        if let Some(outgoing) = self.outgoing.take() {
-            self.discard(outgoing.engine);
-        }
+        // A reset ends every note at once, for the host as well, and forgets the last key: a
+        // host's test note before a reset leaves nothing behind.
+        self.engines.drop_outgoing();
         self.poly.clear();
+        self.last_key = None;
         // Pitch bend, mod wheel and pressure are where the player left them: a host resets
         // the plugin on every start of processing, and the wheel has not moved.
     }
@@ -484,19 +461,27 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         aux: &mut AuxiliaryBuffers,
         context: &mut impl ProcessContext<Self>,
     ) -> ProcessStatus {
+        // Meters are measured only while the editor shows them.
+        let started = self.editor_state.is_open().then(Instant::now);
         let generation = self.params.bank.generation.load(Ordering::Acquire);
-        if generation != self.requested_generation {
-            self.requested_generation = generation;
-            context.execute_background(Task::LoadBank(generation));
+        let failed = self.shared.failed_generation.load(Ordering::Acquire);
+        if let Some(generation) = self.engines.request(generation, failed) {
+            let epoch = self.engines.epoch;
+            context.execute_background(Task::LoadBank { generation, epoch });
         }
-        if self.take_loaded_engine(context) {
+        let rate = f32::from_bits(self.shared.sample_rate_bits.load(Ordering::Acquire));
+        let poly = &mut self.poly;
+        let trashed = self.engines.take_loaded(rate, self.last_key, |note| {
+            report_ended(poly, context, EndedVoice { time: 0, note });
+        });
+        if trashed {
             context.execute_background(Task::CollectGarbage);
         }
         self.read_events(context);
 
         let n = buffer.samples();
         let channels = buffer.as_slice();
-        if self.engine.is_none() || channels.len() < 2 || self.input.is_empty() {
+        if self.engines.current.is_none() || channels.len() < 2 || self.input.is_empty() {
             for channel in channels.iter_mut() {
                 channel.fill(0.0);
             }
@@ -539,12 +524,44 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
             self.expression.apply(change);
         }
 
-        let silent = self.engine.as_ref().is_none_or(|e| e.is_silent()) && self.outgoing.is_none();
+        // Modulation of notes that no longer sound (their end lost, or never started) is
+        // forgotten.
+        if let Some(engine) = self.engines.current.as_ref() {
+            self.poly.retain(|id| engine.has_note_id(id));
+        }
+        if let Some(started) = started {
+            self.editor_shared.measure_block(
+                self.engines.current.as_deref(),
+                self.engines.playing_generation,
+                channels,
+                started.elapsed(),
+                rate,
+            );
+        }
+        let silent = self.engines.current.as_ref().is_none_or(|e| e.is_silent())
+            && self.engines.outgoing.is_none();
         if silent {
             ProcessStatus::Normal
         } else {
             ProcessStatus::KeepAlive
         }
+    }
+}
+
+/// Brings a saved state up to [`STATE_FORMAT`]: states saved before the format was recorded are
+/// format 1, which is still current. A state from a newer version keeps its fields (its newer
+/// ones are ignored).
+pub fn migrate_state(state: &mut PluginState) {
+    let format = state
+        .fields
+        .get(STATE_FORMAT_FIELD)
+        .and_then(|f| f.trim().parse::<u32>().ok())
+        .unwrap_or(1);
+    if format <= STATE_FORMAT {
+        // Migrations from older formats go here, one step at a time.
+        state
+            .fields
+            .insert(STATE_FORMAT_FIELD.to_string(), STATE_FORMAT.to_string());
     }
 }
 
@@ -576,3 +593,33 @@ impl<K: Kind> Vst3Plugin for ModalPlugin<K> {
 
 nice_export_clap!(ModalResonator, ModalResonatorFx);
 nice_export_vst3!(ModalResonator, ModalResonatorFx);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state_with(fields: &[(&str, &str)]) -> PluginState {
+        PluginState {
+            version: String::new(),
+            params: Default::default(),
+            fields: fields
+                .iter()
+                .map(|(k, v)| (k.to_string(), v.to_string()))
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn states_are_brought_to_the_current_format() {
+        // Saved before the format was recorded: format 1.
+        let mut old = state_with(&[("bank", "\"\"")]);
+        migrate_state(&mut old);
+        assert_eq!(old.fields[STATE_FORMAT_FIELD], STATE_FORMAT.to_string());
+        assert_eq!(old.fields["bank"], "\"\"");
+        // A newer format is left as it is.
+        let newer = (STATE_FORMAT + 1).to_string();
+        let mut new = state_with(&[(STATE_FORMAT_FIELD, &newer)]);
+        migrate_state(&mut new);
+        assert_eq!(new.fields[STATE_FORMAT_FIELD], newer);
+    }
+}

@@ -66,6 +66,11 @@ impl PolyTable {
         }
     }
 
+    /// Keeps only the notes for which `keep` holds.
+    pub fn retain(&mut self, mut keep: impl FnMut(i32) -> bool) {
+        self.entries.retain(|e| keep(e.id));
+    }
+
     /// Forgets every note.
     pub fn clear(&mut self) {
         self.entries.clear();

@@ -7,6 +7,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
+use clack_extensions::params::{ParamInfoBuffer, PluginParams};
 use clack_extensions::state::PluginState;
 use clack_host::events::event_types::*;
 use clack_host::events::Match;
@@ -19,12 +20,14 @@ pub const EFFECT: &CStr = c"org.modal-resonator.effect";
 
 pub struct Shared {
     state_ext: OnceLock<Option<PluginState>>,
+    params_ext: OnceLock<Option<PluginParams>>,
     callback_requested: AtomicBool,
 }
 
 impl<'a> SharedHandler<'a> for Shared {
     fn initializing(&self, instance: InitializingPluginHandle<'a>) {
         let _ = self.state_ext.set(instance.get_extension());
+        let _ = self.params_ext.set(instance.get_extension());
     }
     fn request_restart(&self) {}
     fn request_process(&self) {}
@@ -157,6 +160,8 @@ pub struct Script<'a> {
     pub blocks: &'a [usize],
     /// The largest block announced at activation (default: the largest of `blocks`).
     pub max_block: Option<usize>,
+    /// A sample at which the host stops and restarts processing (which resets the plugin).
+    pub restart_at: Option<usize>,
 }
 
 impl<'a> Script<'a> {
@@ -172,6 +177,7 @@ impl<'a> Script<'a> {
             rate: RATE,
             blocks: &[BLOCK],
             max_block: None,
+            restart_at: None,
         }
     }
 }
@@ -316,6 +322,12 @@ fn render_span(
                 left.extend_from_slice(&out[0]);
                 right.extend_from_slice(&out[1]);
                 start += n;
+                if script
+                    .restart_at
+                    .is_some_and(|at| start - n < at && start >= at)
+                {
+                    p = p.stop_processing().start_processing().unwrap();
+                }
                 if let Some((at, _)) = script.swap {
                     if start >= at && !reached.swap(true, Ordering::SeqCst) {
                         while !loaded.load(Ordering::SeqCst) {
@@ -341,9 +353,8 @@ fn render_span(
     })
 }
 
-/// Plays `script` in a fresh instance.
-pub fn run(script: &Script) -> Session {
-    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+/// A fresh instance of `plugin` from the `build` bundle.
+fn instantiate(build: Build, plugin: &CStr) -> PluginInstance<Host> {
     let host_info = HostInfo::new(
         "modal-resonator-tests",
         "Modal Resonator",
@@ -351,17 +362,41 @@ pub fn run(script: &Script) -> Session {
         "0.1.0",
     )
     .unwrap();
-    let mut instance = PluginInstance::<Host>::new(
+    PluginInstance::<Host>::new(
         |_| Shared {
             state_ext: OnceLock::new(),
+            params_ext: OnceLock::new(),
             callback_requested: AtomicBool::new(false),
         },
         |_| (),
-        entry(script.build),
-        script.plugin,
+        entry(build),
+        plugin,
         &host_info,
     )
-    .expect("the plugin instantiates");
+    .expect("the plugin instantiates")
+}
+
+/// The parameters `plugin` lists through the CLAP params extension: id and name.
+pub fn param_infos(plugin: &CStr) -> Vec<(ClapId, String)> {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let mut instance = instantiate(Build::Release, plugin);
+    let ext = instance
+        .access_shared_handler(|h| *h.params_ext.get().unwrap())
+        .expect("params extension");
+    let handle = instance.plugin_handle();
+    let mut buffer = ParamInfoBuffer::new();
+    (0..ext.count(&handle))
+        .map(|i| {
+            let info = ext.get_info(&handle, i, &mut buffer).expect("param info");
+            (info.id, String::from_utf8_lossy(info.name).into_owned())
+        })
+        .collect()
+}
+
+/// Plays `script` in a fresh instance.
+pub fn run(script: &Script) -> Session {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let mut instance = instantiate(script.build, script.plugin);
     let state_ext = instance
         .access_shared_handler(|h| *h.state_ext.get().unwrap())
         .expect("state extension");
@@ -428,9 +463,19 @@ pub fn run(script: &Script) -> Session {
 
 /// `state` (a saved CLAP state: length, then JSON) with `bank` as its saved bank.
 pub fn with_bank(state: &[u8], bank: &modal_resonator::model::Bank) -> Vec<u8> {
+    with_bank_text(state, &modal_resonator::model::io::bank_to_json(bank))
+}
+
+/// The saved bank's JSON text in `state`.
+pub fn bank_text(state: &[u8]) -> String {
+    let json: serde_json::Value = serde_json::from_slice(&state[8..]).unwrap();
+    serde_json::from_str(json["fields"]["bank"].as_str().unwrap()).unwrap()
+}
+
+/// `state` with `text` (valid or not) as its saved bank's JSON.
+pub fn with_bank_text(state: &[u8], text: &str) -> Vec<u8> {
     let mut json: serde_json::Value = serde_json::from_slice(&state[8..]).unwrap();
-    let bank_json = modal_resonator::model::io::bank_to_json(bank);
-    json["fields"]["bank"] = serde_json::Value::String(serde_json::to_string(&bank_json).unwrap());
+    json["fields"]["bank"] = serde_json::Value::String(serde_json::to_string(text).unwrap());
     let text = serde_json::to_string(&json).unwrap();
     let mut bytes = (text.len() as u64).to_le_bytes().to_vec();
     bytes.extend_from_slice(text.as_bytes());

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod clap;
+pub mod recordings;
 
 use std::sync::Arc;
 

@@ -5,22 +5,18 @@
 //! Frey ch. 4): ratios 1 : 1.594 : 2.136 : 2.296 : 2.653 : 2.918 ... Mode shapes
 //! `J_m(j_mn r / a) cos(m theta)` and, for `m > 0`, a `sin(m theta)` twin at the same frequency.
 //!
-//! Positions are `(x, y)` in fractions of the radius from the centre. Angles are measured from
-//! the x axis, so with every position on it (`y = 0`) the sine twins are silent everywhere and
-//! are left out; they are added, for the orders that need them, when some position is off the
-//! axis. The air that loads a real drum head lowers and spreads its low modes (timpani are
+//! Positions are `(x, y)` in fractions of the radius from the centre; the sine twins are added
+//! only when some position needs them (see `disc.rs`). The air that loads a real drum head lowers and spreads its low modes (timpani are
 //! tuned that way); it is not modelled.
 
 use super::bessel::{bessel_j_upto, bessel_zeros_below};
+use super::disc::DiscPoints;
 use super::{ModeLimits, ShapeError, ShapedMode};
 use crate::model::materials::Material;
 use std::f64::consts::{SQRT_2, TAU};
 
 /// First zero of `J_0`, which sets the fundamental.
 const J_0_1: f64 = 2.404_825_557_695_773;
-
-/// Below this `|sin(m theta)|` a position is taken to be on a nodal diameter of the sine twin.
-const ON_AXIS_EPS: f64 = 1e-9;
 
 /// First argument bound of the search for Bessel zeros, grown by half until enough are found.
 const FIRST_ZERO_SEARCH_BOUND: f64 = 16.0;
@@ -80,15 +76,7 @@ impl CircularMembrane {
         coords: &[[f64; 2]],
         limits: &ModeLimits,
     ) -> Vec<ShapedMode> {
-        let polar: Vec<(f64, f64)> = coords
-            .iter()
-            .map(|&[x, y]| (x.hypot(y), y.atan2(x)))
-            .collect();
-        let needs_sine = |m: usize| {
-            polar
-                .iter()
-                .any(|&(_, angle)| (m as f64 * angle).sin().abs() > ON_AXIS_EPS)
-        };
+        let points = DiscPoints::new(coords);
 
         // Bessel argument of the frequency limit. Every zero below the current bound is found,
         // so once there are enough of them the lowest ones are the lowest of all.
@@ -100,10 +88,9 @@ impl CircularMembrane {
             let mut count = 0;
             // j_m1 > m: orders at or above the bound have no zero below it.
             for m in 0..bound.ceil() as usize {
-                let twins = if m > 0 && needs_sine(m) { 2 } else { 1 };
                 for j in bessel_zeros_below(m, bound) {
                     zeros.push((m, j));
-                    count += twins;
+                    count += points.modes_per_root(m);
                 }
             }
             if count >= limits.max_modes || bound >= zero_limit {
@@ -120,27 +107,9 @@ impl CircularMembrane {
             // int_0^1 J_m(j r)^2 r dr = J_(m+1)(j)^2 / 2 at a zero j of J_m.
             let j_next = bessel_j_upto(m + 1, j)[m + 1].abs();
             let norm = if m == 0 { j_next } else { j_next / SQRT_2 };
-            let radial: Vec<f64> = polar
-                .iter()
-                .map(|&(r, _)| bessel_j_upto(m, j * r)[m] / norm)
-                .collect();
-            let angular = |f: fn(f64) -> f64| -> Vec<f64> {
-                radial
-                    .iter()
-                    .zip(&polar)
-                    .map(|(value, &(_, angle))| value * f(m as f64 * angle))
-                    .collect()
-            };
-            modes.push(ShapedMode {
-                freq_hz,
-                shape: angular(f64::cos),
+            points.push_modes(&mut modes, freq_hz, m, |r| {
+                bessel_j_upto(m, j * r)[m] / norm
             });
-            if m > 0 && needs_sine(m) {
-                modes.push(ShapedMode {
-                    freq_hz,
-                    shape: angular(f64::sin),
-                });
-            }
         }
         modes
     }

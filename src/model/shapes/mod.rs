@@ -1,5 +1,6 @@
-//! Analytic shapes: the closed-form modes of strings, bars, membranes, plates and bells, and the
-//! banks built from them (seed 000 section 3.1).
+//! Analytic shapes: the closed-form modes of strings, bars (free and clamped), membranes and
+//! plates (rectangular and circular) and bells, and the banks built from them (seed 000
+//! section 3.1).
 //!
 //! Each object yields, for every mode, a frequency, and the value of its mode shape `Psi_n` at
 //! each strike position, normalised to unit mean square over the object (the norm `alpha_n` of
@@ -15,16 +16,28 @@
 pub mod bar;
 pub mod bell;
 pub mod bessel;
+pub mod cantilever;
+pub mod circular_plate;
+pub mod design;
+mod disc;
+mod lattice;
 pub mod membrane;
+pub mod objects;
 pub mod plate;
 mod positions;
+pub mod rect_membrane;
 mod shape;
+mod shape_describe;
 pub mod string;
 
 pub use bar::{Bar, TunedBar, MARIMBA_RATIOS, VIBRAPHONE_RATIOS, XYLOPHONE_RATIOS};
 pub use bell::{BellPartial, TunedBell, TUNED_BELL_PARTIALS};
+pub use circular_plate::{CircularPlate, PlateEdge};
+pub use design::{design_bank, BankDesign};
 pub use membrane::CircularMembrane;
+pub use objects::{Dimension, ObjectKind, ObjectSpec, BAR_TUNINGS, OBJECTS};
 pub use plate::RectangularPlate;
+pub use rect_membrane::RectangularMembrane;
 pub use shape::Shape;
 pub use string::StretchedString;
 

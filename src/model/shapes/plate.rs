@@ -8,6 +8,7 @@
 //!
 //! Positions are `(x / a, y / b)`, fractions of the sides from a corner.
 
+use super::lattice::lowest_lattice_modes;
 use super::{ModeLimits, ShapeError, ShapedMode};
 use crate::model::materials::Material;
 use std::f64::consts::{FRAC_PI_2, PI};
@@ -78,28 +79,14 @@ impl RectangularPlate {
         coords: &[[f64; 2]],
         limits: &ModeLimits,
     ) -> Vec<ShapedMode> {
-        // Enumerate below a bound that holds a little over the wanted count, widened until it
-        // does, so that a large thin plate does not list millions of modes to keep 300.
+        // A first bound that holds a little over the wanted count.
         let per_hz = self.approx_mode_count(material, 1.0);
-        let mut bound_hz = (2.0 * limits.max_modes as f64 / per_hz).min(limits.max_freq_hz);
-        let indices = loop {
-            let mut indices = Vec::new();
-            for m in 1.. {
-                if self.mode_freq_hz(material, m, 1) >= bound_hz {
-                    break;
-                }
-                for n in 1.. {
-                    if self.mode_freq_hz(material, m, n) >= bound_hz {
-                        break;
-                    }
-                    indices.push((m, n));
-                }
-            }
-            if indices.len() >= limits.max_modes || bound_hz >= limits.max_freq_hz {
-                break indices;
-            }
-            bound_hz = (2.0 * bound_hz).min(limits.max_freq_hz);
-        };
+        let indices = lowest_lattice_modes(
+            |m, n| self.mode_freq_hz(material, m, n),
+            2.0 * limits.max_modes as f64 / per_hz,
+            limits.max_freq_hz,
+            limits.max_modes,
+        );
 
         indices
             .into_iter()

@@ -1,0 +1,126 @@
+//! `modal-resonator fit`: a bank from recordings of an object struck at one or more positions.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use modal_resonator::model::fit::{fit_bank, read_wav_recording, save_report_file, FitOptions};
+use modal_resonator::model::save_bank_file;
+
+use super::{check_output_dir, same_file};
+
+/// Arguments of `fit`.
+#[derive(Debug, Args)]
+pub(super) struct FitArgs {
+    /// WAV recordings (mono or stereo) of one strike each, one per position, as FILE.wav or
+    /// FILE.wav=POSITION; the position is named after the file when not given.
+    #[arg(required = true, value_name = "FILE[=POSITION]")]
+    recordings: Vec<String>,
+    /// Bank file (JSON) to write.
+    #[arg(short, long, value_name = "FILE")]
+    output: PathBuf,
+    /// Most modes in the bank: the strongest by energy are kept.
+    #[arg(long, default_value_t = 64)]
+    modes: usize,
+    /// Lowest mode frequency searched, in Hz.
+    #[arg(long, default_value_t = 20.0)]
+    min_hz: f64,
+    /// Highest mode frequency searched, in Hz (never above 0.45 times the sample rate).
+    #[arg(long, default_value_t = 20_000.0)]
+    max_hz: f64,
+    /// Noise floor in dBFS: the weakest mode amplitude trusted, and where decay fits stop.
+    /// Estimated from each recording when not given.
+    #[arg(long, allow_hyphen_values = true, value_name = "DB")]
+    noise_floor_db: Option<f64>,
+    /// Analysis window in milliseconds: longer separates closer modes, shorter follows faster
+    /// decays.
+    #[arg(long, default_value_t = 170.0, value_name = "MS")]
+    window_ms: f64,
+    /// Longest stretch of each recording analysed after the strike, in seconds.
+    #[arg(long, default_value_t = 10.0)]
+    max_seconds: f64,
+    /// Bank name (default: the output file's name).
+    #[arg(long)]
+    name: Option<String>,
+    /// Author written into the bank.
+    #[arg(long, default_value = "")]
+    author: String,
+    /// SPDX licence of the bank, usually that of the recordings, e.g. CC0-1.0.
+    #[arg(long, default_value = "")]
+    license: String,
+    /// Also write the report to this file: JSON if it ends in .json, else text.
+    #[arg(long, value_name = "FILE")]
+    report: Option<PathBuf>,
+}
+
+/// `fit`: reads every recording, fits, writes the bank (and the report if asked) and prints the
+/// report. Nothing is written on failure.
+pub(super) fn run(args: &FitArgs) -> Result<(), String> {
+    check_output_dir(&args.output)?;
+    let mut recordings = Vec::with_capacity(args.recordings.len());
+    for arg in &args.recordings {
+        let (path, position) = split_recording_arg(arg);
+        if same_file(&path, &args.output) {
+            return Err(format!(
+                "{}: the output would overwrite an input",
+                args.output.display()
+            ));
+        }
+        recordings.push(read_wav_recording(&path, &position).map_err(|e| e.to_string())?);
+    }
+    if let Some(report) = &args.report {
+        check_output_dir(report)?;
+    }
+    let name = args.name.clone().unwrap_or_else(|| {
+        args.output
+            .file_stem()
+            .map_or("Fitted bank".to_string(), |s| {
+                s.to_string_lossy().into_owned()
+            })
+    });
+    let options = FitOptions {
+        name,
+        max_modes: args.modes,
+        min_hz: args.min_hz,
+        max_hz: args.max_hz,
+        noise_floor_db: args.noise_floor_db,
+        window_s: args.window_ms * 1e-3,
+        max_seconds: args.max_seconds,
+    };
+    let mut fit = fit_bank(&recordings, &options).map_err(|e| e.to_string())?;
+    fit.bank.author = args.author.clone();
+    fit.bank.license = args.license.clone();
+    save_bank_file(&fit.bank, &args.output).map_err(|e| e.to_string())?;
+    if let Some(path) = &args.report {
+        save_report_file(&fit.report, path)
+            .map_err(|e| format!("{}: cannot write the report: {e}", path.display()))?;
+    }
+    print!("{}", fit.report);
+    for r in &fit.report.recordings {
+        for w in &r.warnings {
+            eprintln!("warning: {}: {w}", r.name);
+        }
+    }
+    println!(
+        "{}: {} modes, {} positions",
+        args.output.display(),
+        fit.bank.modes.len(),
+        fit.bank.positions.len()
+    );
+    Ok(())
+}
+
+/// `FILE=POSITION` or `FILE`: the file and the position name (the file's stem when not given).
+/// A file whose own name holds `=` is taken whole when it exists.
+fn split_recording_arg(arg: &str) -> (PathBuf, String) {
+    let whole = PathBuf::from(arg);
+    if let Some((file, position)) = arg.rsplit_once('=') {
+        if !whole.exists() {
+            return (PathBuf::from(file), position.to_string());
+        }
+    }
+    let position = whole
+        .file_stem()
+        .map_or_else(|| arg.to_string(), |s| s.to_string_lossy().into_owned());
+    (whole, position)
+}

@@ -1,0 +1,142 @@
+//! The `modal-resonator` command line: one file per subcommand, each thin over the library
+//! (`modal_resonator`), where every decision about sound lives.
+
+mod compress;
+mod fit;
+mod info;
+mod list;
+mod play;
+mod render;
+mod schema;
+mod shape;
+mod validate;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use modal_resonator::model::factory::{factory_bank, factory_banks, factory_slug};
+use modal_resonator::model::{load_bank_file, Bank};
+
+/// Modal Resonator: modal-synthesis instrument and bank tool.
+#[derive(Debug, Parser)]
+#[command(name = "modal-resonator", version, about)]
+struct Cli {
+    /// What to do; with none, plays the instrument standalone (as `play`, taking its options:
+    /// `modal-resonator --backend dummy`).
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Play the instrument standalone: audio and MIDI through JACK or ALSA (`--backend dummy`
+    /// runs headless). Options after `play` go to the standalone; `play --help` lists them.
+    Play {
+        /// Standalone options, e.g. --backend alsa --sample-rate 48000 --period-size 256.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
+    /// Render notes or a MIDI file through a bank to a stereo WAV file.
+    Render(render::RenderArgs),
+    /// Fit a bank to recordings of an object struck at one or more positions.
+    Fit(fit::FitArgs),
+    /// Make a bank from an analytic object (string, bar, tine, membrane, plate, disc, bell) of
+    /// given dimensions and material.
+    Shape(Box<shape::ShapeArgs>),
+    /// Make a bank cheaper: merge modes closer than the frequency difference limen and drop
+    /// modes far below the strongest.
+    Compress(compress::CompressArgs),
+    /// Check bank files and print every problem found.
+    Validate {
+        /// Bank files (JSON).
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+    },
+    /// Describe a bank: modes, positions, frequency range, T60s.
+    Info {
+        /// Bank file (JSON) or factory preset name.
+        bank: String,
+    },
+    /// List the factory banks.
+    List,
+    /// Print the JSON Schema of the bank format.
+    Schema,
+}
+
+/// Parses the command line, runs the subcommand, and reports an error on stderr.
+pub fn main() -> ExitCode {
+    // Options with no subcommand go to the standalone: `modal-resonator --backend dummy`.
+    let argv: Vec<String> = std::env::args().skip(1).collect();
+    let standalone_options = argv
+        .first()
+        .is_some_and(|a| a.starts_with("--") && a != "--help" && a != "--version");
+    let cli = if standalone_options {
+        Cli {
+            command: Some(Command::Play { args: argv }),
+        }
+    } else {
+        Cli::parse()
+    };
+    let result = match cli.command {
+        Some(Command::Render(args)) => render::run(&args),
+        Some(Command::Fit(args)) => fit::run(&args),
+        Some(Command::Shape(args)) => shape::run(&args),
+        Some(Command::Compress(args)) => compress::run(&args),
+        Some(Command::Validate { files }) => validate::run(&files),
+        Some(Command::Info { bank }) => info::run(&bank),
+        Some(Command::List) => list::run(),
+        Some(Command::Schema) => schema::run(),
+        Some(Command::Play { args }) => play::run(args),
+        None => play::run(Vec::new()),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Loads the bank named on the command line: a bank file (validated) if `arg` is a path that
+/// exists, else the factory bank of that name or slug.
+pub(super) fn load_bank(arg: &str) -> Result<Bank, String> {
+    let path = Path::new(arg);
+    if path.exists() {
+        return load_bank_file(path).map_err(|e| e.to_string());
+    }
+    factory_bank(arg).ok_or_else(|| {
+        let names: Vec<String> = factory_banks().iter().map(factory_slug).collect();
+        format!(
+            "no bank file or factory preset named \"{arg}\"; factory presets: {}",
+            names.join(", ")
+        )
+    })
+}
+
+/// Fails early, before a long render, when the output is a directory or its directory does not
+/// exist.
+pub(super) fn check_output_dir(output: &Path) -> Result<(), String> {
+    if output.is_dir() {
+        return Err(format!("{}: is a directory", output.display()));
+    }
+    match output.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => Err(format!(
+            "{}: directory {} does not exist",
+            output.display(),
+            dir.display()
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Whether `a` and `b` name the same existing file.
+pub(super) fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}

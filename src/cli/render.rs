@@ -1,0 +1,154 @@
+//! `modal-resonator render`: notes or a MIDI file through a bank to a WAV file.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use modal_resonator::engine::{Controls, PreparedBank};
+use modal_resonator::render::{
+    parse_notes, read_midi_file, render, write_wav, BitDepth, Note, RenderSettings,
+};
+
+use super::{check_output_dir, load_bank, same_file};
+
+/// Work after which a progress bar appears, so quick renders print nothing but the summary.
+const PROGRESS_DELAY: Duration = Duration::from_secs(1);
+
+/// Steps of the progress bar.
+const PROGRESS_STEPS: u64 = 1000;
+
+/// Arguments of `render`.
+#[derive(Debug, Args)]
+#[command(group(clap::ArgGroup::new("input").required(true).args(["notes", "midi"])))]
+pub(super) struct RenderArgs {
+    /// Bank file (JSON) or factory preset name.
+    bank: String,
+    /// Notes as key:velocity@time_s[+duration_s], comma-separated, e.g. "60:0.8@0, 64:0.5@0.25+0.5".
+    #[arg(long)]
+    notes: Option<String>,
+    /// Standard MIDI file to play (all tracks and channels).
+    #[arg(long, value_name = "FILE")]
+    midi: Option<PathBuf>,
+    /// WAV file to write.
+    #[arg(short, long, value_name = "FILE")]
+    output: PathBuf,
+    /// Set a control on top of the bank's defaults, e.g. --set material=wood; repeatable.
+    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = parse_assignment)]
+    set: Vec<(String, String)>,
+    /// Sample rate in Hz.
+    #[arg(long, default_value_t = 48_000, value_parser = clap::value_parser!(u32).range(8_000..=384_000))]
+    rate: u32,
+    /// Bits per sample: 16 or 24 (integer) or 32 (float).
+    #[arg(long, default_value = "24", value_parser = parse_bit_depth)]
+    bits: BitDepth,
+    /// Longest render in seconds; the render stops earlier once everything is silent.
+    #[arg(long, default_value_t = 30.0, value_parser = parse_max_seconds)]
+    max_seconds: f64,
+}
+
+/// `render`: everything is checked before rendering, and nothing is written on failure.
+pub(super) fn run(args: &RenderArgs) -> Result<(), String> {
+    let bank = load_bank(&args.bank)?;
+    let mut controls = Controls::for_bank(&bank);
+    for (name, value) in &args.set {
+        controls
+            .set_by_name(name, value)
+            .map_err(|e| format!("--set {name}={value}: {e}"))?;
+    }
+    let notes: Vec<Note> = match (&args.notes, &args.midi) {
+        (Some(text), _) => parse_notes(text).map_err(|e| format!("--notes: {e}"))?,
+        (None, Some(path)) => read_midi_file(path).map_err(|e| e.to_string())?,
+        (None, None) => unreachable!("clap requires --notes or --midi"),
+    };
+    if let Some(late) = notes.iter().position(|n| n.time_s >= args.max_seconds) {
+        return Err(format!(
+            "note {} starts at {} s, at or after --max-seconds {}",
+            late + 1,
+            notes[late].time_s,
+            args.max_seconds
+        ));
+    }
+    check_output_dir(&args.output)?;
+    let inputs = [Some(Path::new(&args.bank)), args.midi.as_deref()];
+    for input in inputs.into_iter().flatten() {
+        if same_file(input, &args.output) {
+            return Err(format!(
+                "{}: the output would overwrite an input",
+                args.output.display()
+            ));
+        }
+    }
+    let settings = RenderSettings {
+        sample_rate_hz: args.rate,
+        bit_depth: args.bits,
+        controls,
+        max_seconds: args.max_seconds,
+        ..RenderSettings::default()
+    };
+
+    let started = Instant::now();
+    let bank = Arc::new(PreparedBank::new(&bank));
+    let bar = ProgressBar::with_draw_target(Some(PROGRESS_STEPS), ProgressDrawTarget::hidden());
+    bar.set_style(
+        ProgressStyle::with_template("rendering {bar:40} {percent:>3}% {elapsed}")
+            .expect("a valid template"),
+    );
+    let mut show_bar = std::io::stderr().is_terminal();
+    let rendered = render(&bank, &notes, &settings, |done| {
+        if show_bar && started.elapsed() >= PROGRESS_DELAY {
+            bar.set_draw_target(ProgressDrawTarget::stderr());
+            show_bar = false;
+        }
+        bar.set_position((done * PROGRESS_STEPS as f64) as u64);
+    });
+    bar.finish_and_clear();
+    write_wav(&args.output, &rendered, args.bits, args.rate).map_err(|e| e.to_string())?;
+
+    let peak_dbfs = rendered.peak_dbfs();
+    let clipped = args.bits != BitDepth::Float32 && rendered.peak() > 1.0;
+    println!(
+        "{}: {:.2} s, {} Hz {}, peak {:.1} dBFS{}, up to {} voices, rendered in {:.2} s{}",
+        args.output.display(),
+        rendered.duration_s(),
+        args.rate,
+        args.bits.name(),
+        peak_dbfs,
+        if clipped { " (clipped)" } else { "" },
+        rendered.max_voices,
+        started.elapsed().as_secs_f64(),
+        if rendered.cut_short {
+            ", cut at --max-seconds"
+        } else {
+            ""
+        },
+    );
+    Ok(())
+}
+
+/// Parses `NAME=VALUE` for `--set`.
+fn parse_assignment(text: &str) -> Result<(String, String), String> {
+    let (name, value) = text
+        .split_once('=')
+        .ok_or_else(|| format!("expected NAME=VALUE, found \"{text}\""))?;
+    Ok((name.trim().to_string(), value.trim().to_string()))
+}
+
+/// Parses `--bits`.
+fn parse_bit_depth(text: &str) -> Result<BitDepth, String> {
+    text.parse::<u16>()
+        .ok()
+        .and_then(BitDepth::from_bits)
+        .ok_or_else(|| format!("expected 16, 24 or 32, found \"{text}\""))
+}
+
+/// Parses `--max-seconds`: a positive number.
+fn parse_max_seconds(text: &str) -> Result<f64, String> {
+    text.parse::<f64>()
+        .ok()
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .ok_or_else(|| format!("expected a number of seconds above 0, found \"{text}\""))
+}

@@ -1,0 +1,205 @@
+//! Every host parameter as a labelled control with its value and unit, in groups. Sliders reset
+//! on double-click (or Ctrl-click), move finely with Shift held, and take typed values when their
+//! value is clicked; they read the parameters every frame, so host automation moves them live.
+
+use egui::{CollapsingHeader, ComboBox, Grid, Ui};
+use nice_plug::prelude::{BoolParam, Enum, EnumParam, FloatParam, IntParam, Param, ParamSetter};
+use nice_plug_egui::widgets::ParamSlider;
+
+use crate::params::ModalParams;
+
+/// Room the label and value columns need beside a slider, in points.
+const LABEL_AND_VALUE_WIDTH: f32 = 215.0;
+/// Narrowest and widest slider, in points.
+const SLIDER_WIDTH: (f32, f32) = (70.0, 150.0);
+
+/// One control.
+enum Control<'a> {
+    Float(&'a FloatParam),
+    Int(&'a IntParam),
+    Bool(&'a BoolParam),
+    /// An enum parameter: its name, current index and a setter by index.
+    Choice(&'a dyn ChoiceParam),
+}
+
+/// An enum parameter seen without its type.
+trait ChoiceParam {
+    fn name(&self) -> &str;
+    fn variants(&self) -> &'static [&'static str];
+    fn index(&self) -> usize;
+    fn set_index(&self, setter: &ParamSetter, index: usize);
+    fn default_index(&self) -> usize;
+}
+
+impl<T: Enum + PartialEq + 'static> ChoiceParam for EnumParam<T> {
+    fn name(&self) -> &str {
+        Param::name(self)
+    }
+    fn variants(&self) -> &'static [&'static str] {
+        T::variants()
+    }
+    fn index(&self) -> usize {
+        self.value().to_index()
+    }
+    fn set_index(&self, setter: &ParamSetter, index: usize) {
+        setter.begin_set_parameter(self);
+        setter.set_parameter(self, T::from_index(index));
+        setter.end_set_parameter(self);
+    }
+    fn default_index(&self) -> usize {
+        self.default_plain_value().to_index()
+    }
+}
+
+/// The groups and their controls, in display order.
+fn groups(p: &ModalParams, is_effect: bool) -> Vec<(&'static str, Vec<Control<'_>>)> {
+    use Control::*;
+    let mut output = vec![Float(&p.output_gain), Float(&p.width)];
+    if is_effect {
+        output.push(Float(&p.dry_wet));
+    }
+    vec![
+        (
+            "Object",
+            vec![
+                Float(&p.size),
+                Float(&p.key_tracking),
+                Float(&p.fine_tune),
+                Float(&p.bend_range),
+            ],
+        ),
+        (
+            "Strike",
+            vec![
+                Float(&p.strike_x),
+                Float(&p.strike_y),
+                Float(&p.position_variation),
+                Choice(&p.exciter),
+                Float(&p.hardness),
+                Float(&p.velocity_sensitivity),
+                Float(&p.velocity_to_hardness),
+            ],
+        ),
+        (
+            "Material",
+            vec![
+                Choice(&p.material),
+                Float(&p.material_q),
+                Float(&p.damping_tilt),
+                Float(&p.release_damping),
+            ],
+        ),
+        (
+            "Voices",
+            vec![
+                Int(&p.polyphony),
+                Float(&p.truncation),
+                Choice(&p.mod_wheel_target),
+                Choice(&p.pressure_target),
+                Bool(&p.mpe),
+                Float(&p.mpe_bend_range),
+            ],
+        ),
+        ("Output", output),
+        (
+            "Input",
+            vec![
+                Choice(&p.input_mode),
+                Float(&p.input_gain),
+                Float(&p.trigger_threshold),
+                Float(&p.retrigger),
+            ],
+        ),
+    ]
+}
+
+/// The names of every parameter the panel shows, in order (for tests).
+pub fn shown_names(params: &ModalParams, is_effect: bool) -> Vec<String> {
+    groups(params, is_effect)
+        .iter()
+        .flat_map(|(_, controls)| controls.iter().map(control_name))
+        .collect()
+}
+
+fn control_name(c: &Control) -> String {
+    match c {
+        Control::Float(p) => p.name().to_string(),
+        Control::Int(p) => p.name().to_string(),
+        Control::Bool(p) => p.name().to_string(),
+        Control::Choice(p) => p.name().to_string(),
+    }
+}
+
+/// Draws the parameter groups in a panel `panel_width` points wide (the width the panel starts
+/// with: sizing the sliders by the width left would let the panel creep frame by frame).
+pub fn show(
+    ui: &mut Ui,
+    params: &ModalParams,
+    setter: &ParamSetter,
+    is_effect: bool,
+    panel_width: f32,
+) {
+    let width = (panel_width - LABEL_AND_VALUE_WIDTH).clamp(SLIDER_WIDTH.0, SLIDER_WIDTH.1);
+    ui.label(
+        egui::RichText::new("Double-click resets · Shift-drag fine · click a value to type")
+            .small()
+            .weak(),
+    );
+    for (group, controls) in groups(params, is_effect) {
+        CollapsingHeader::new(group)
+            .default_open(true)
+            .show(ui, |ui| {
+                Grid::new(group)
+                    .num_columns(2)
+                    .spacing([8.0, 4.0])
+                    .show(ui, |ui| {
+                        for control in &controls {
+                            ui.label(control_name(control));
+                            show_control(ui, control, setter, width);
+                            ui.end_row();
+                        }
+                    });
+            });
+    }
+}
+
+fn show_control(ui: &mut Ui, control: &Control, setter: &ParamSetter, width: f32) {
+    match control {
+        Control::Float(p) => {
+            ui.add(ParamSlider::for_param(*p, setter).with_width(width));
+        }
+        Control::Int(p) => {
+            ui.add(ParamSlider::for_param(*p, setter).with_width(width));
+        }
+        Control::Bool(p) => {
+            let mut on = p.value();
+            let text = if on { "On" } else { "Off" };
+            let response = ui.checkbox(&mut on, text);
+            if response.changed() {
+                setter.begin_set_parameter(*p);
+                setter.set_parameter(*p, on);
+                setter.end_set_parameter(*p);
+            }
+        }
+        Control::Choice(p) => {
+            let variants = p.variants();
+            let current = p.index();
+            let mut chosen = current;
+            let response = ComboBox::from_id_salt(p.name())
+                .width(width)
+                .selected_text(variants.get(current).copied().unwrap_or("?"))
+                .show_ui(ui, |ui| {
+                    for (i, name) in variants.iter().enumerate() {
+                        ui.selectable_value(&mut chosen, i, *name);
+                    }
+                })
+                .response;
+            if response.double_clicked() {
+                chosen = p.default_index();
+            }
+            if chosen != current {
+                p.set_index(setter, chosen);
+            }
+        }
+    }
+}

@@ -1,0 +1,202 @@
+//! The engines of one plugin instance: the one playing, the one fading out after a bank swap, and
+//! those on their way in from the background thread and back to it to be dropped. The audio
+//! thread never builds or drops an engine.
+
+use crossbeam_channel::{Receiver, Sender};
+
+use super::bank_loader::LoadedEngine;
+use crate::engine::{Engine, Note};
+
+/// Engines handed to the background thread at once, before one waits for room.
+const TRASH_CAPACITY: usize = 8;
+
+/// Engines kept on the audio thread while the trash is full.
+const WAITING_SLOTS: usize = 4;
+
+/// Built engines waiting for the audio thread.
+const LOADED_CAPACITY: usize = 4;
+
+/// Blocks without the requested bank before it is asked for again (a request or a built engine
+/// can be lost when a queue is full).
+const RETRY_BLOCKS: u32 = 256;
+
+/// The background thread's ends of the channels.
+pub struct BackgroundEnds {
+    /// Where built engines go.
+    pub loaded_tx: Sender<LoadedEngine>,
+    /// Where old engines come from, to be dropped.
+    pub trash_rx: Receiver<Box<Engine>>,
+}
+
+/// The engine that was playing before a bank swap, fading out.
+pub struct Outgoing {
+    /// The engine.
+    pub engine: Box<Engine>,
+    /// Its gain now, 1 down to 0.
+    pub gain: f32,
+}
+
+/// The audio thread's engines.
+pub struct Engines {
+    /// The engine playing; `None` until activated.
+    pub current: Option<Box<Engine>>,
+    /// The engine that played before the last swap, while it fades out.
+    pub outgoing: Option<Outgoing>,
+    /// Engines built by the background thread.
+    loaded_rx: Receiver<LoadedEngine>,
+    /// Engines to drop, for the background thread.
+    trash_tx: Sender<Box<Engine>>,
+    /// Old engines waiting for room in the trash.
+    waiting: [Option<Box<Engine>>; WAITING_SLOTS],
+    /// The bank generation last asked for.
+    pub requested_generation: u64,
+    /// The bank generation of the engine playing.
+    pub playing_generation: u64,
+    /// Incremented on every activation: engines built for an earlier one are not used.
+    pub epoch: u64,
+    /// Blocks since the requested bank was last asked for.
+    blocks_waiting: u32,
+}
+
+impl Engines {
+    /// No engines yet, and the channels to the background thread.
+    pub fn new() -> (Self, BackgroundEnds) {
+        let (loaded_tx, loaded_rx) = crossbeam_channel::bounded(LOADED_CAPACITY);
+        let (trash_tx, trash_rx) = crossbeam_channel::bounded(TRASH_CAPACITY);
+        let engines = Self {
+            current: None,
+            outgoing: None,
+            loaded_rx,
+            trash_tx,
+            waiting: Default::default(),
+            requested_generation: 0,
+            playing_generation: 0,
+            epoch: 0,
+            blocks_waiting: 0,
+        };
+        (
+            engines,
+            BackgroundEnds {
+                loaded_tx,
+                trash_rx,
+            },
+        )
+    }
+
+    /// Starts over with `engine` for bank `generation` (on activation, off the audio thread):
+    /// anything built for an earlier activation is ignored.
+    pub fn activate(&mut self, engine: Box<Engine>, generation: u64) {
+        self.current = Some(engine);
+        self.outgoing = None;
+        self.epoch += 1;
+        self.requested_generation = generation;
+        self.playing_generation = generation;
+        while self.loaded_rx.try_recv().is_ok() {}
+    }
+
+    /// The bank generation to ask the background thread for, if any: a new one, or one asked
+    /// for long ago that has not arrived (and did not fail to load, per `failed_generation`).
+    /// Call once per block.
+    pub fn request(&mut self, generation: u64, failed_generation: u64) -> Option<u64> {
+        if generation != self.requested_generation {
+            self.requested_generation = generation;
+            self.blocks_waiting = 0;
+            return Some(generation);
+        }
+        if self.playing_generation == generation || failed_generation == generation {
+            return None;
+        }
+        self.blocks_waiting += 1;
+        if self.blocks_waiting >= RETRY_BLOCKS {
+            self.blocks_waiting = 0;
+            return Some(generation);
+        }
+        None
+    }
+
+    /// Swaps in an engine the background thread built for the current request, if one has
+    /// arrived; the one playing fades out. `sample_rate_hz` is the rate now. Each note of the
+    /// engine leaving goes to `ended` (the host can forget them: they take no more events).
+    /// Returns whether any engine went to the trash.
+    pub fn take_loaded(
+        &mut self,
+        sample_rate_hz: f32,
+        last_key: Option<u8>,
+        mut ended: impl FnMut(Note),
+    ) -> bool {
+        let mut trashed = self.flush_waiting();
+        while let Ok(loaded) = self.loaded_rx.try_recv() {
+            // Superseded by a newer request, or built for an earlier activation or another
+            // sample rate: discard it. Otherwise swap it in and let the old one fade out.
+            let wanted = loaded.generation == self.requested_generation
+                && loaded.epoch == self.epoch
+                && loaded.engine.sample_rate_hz() == sample_rate_hz;
+            let old = if wanted {
+                let mut engine = loaded.engine;
+                engine.set_last_key(last_key);
+                self.playing_generation = loaded.generation;
+                match self.current.replace(engine) {
+                    Some(old) if !old.is_silent() => {
+                        old.notes().for_each(&mut ended);
+                        // A fade already under way is cut short by the newer swap.
+                        let cut = self.outgoing.replace(Outgoing {
+                            engine: old,
+                            gain: 1.0,
+                        });
+                        cut.map(|o| o.engine)
+                    }
+                    old => old,
+                }
+            } else {
+                Some(loaded.engine)
+            };
+            if let Some(old) = old {
+                trashed |= self.discard(old);
+            }
+        }
+        trashed
+    }
+
+    /// Ends the outgoing engine's fade at once (on a reset).
+    pub fn drop_outgoing(&mut self) -> bool {
+        match self.outgoing.take() {
+            Some(o) => self.discard(o.engine),
+            None => false,
+        }
+    }
+
+    /// Hands `engine` to the background thread to be dropped there, or keeps it until there is
+    /// room. Returns whether it went to the background thread. Never drops it here: with every
+    /// slot taken (the background thread stalled for many swaps) it is leaked instead, which
+    /// costs memory but never the audio thread's time.
+    pub fn discard(&mut self, engine: Box<Engine>) -> bool {
+        match self.trash_tx.try_send(engine) {
+            Ok(()) => true,
+            Err(e) => {
+                let engine = e.into_inner();
+                match self.waiting.iter_mut().find(|w| w.is_none()) {
+                    Some(slot) => *slot = Some(engine),
+                    None => std::mem::forget(engine),
+                }
+                false
+            }
+        }
+    }
+
+    /// Retries the engines waiting for room in the trash. Returns whether any went.
+    fn flush_waiting(&mut self) -> bool {
+        let mut sent = false;
+        for slot in self.waiting.iter_mut() {
+            if let Some(engine) = slot.take() {
+                match self.trash_tx.try_send(engine) {
+                    Ok(()) => sent = true,
+                    Err(e) => {
+                        *slot = Some(e.into_inner());
+                        break;
+                    }
+                }
+            }
+        }
+        sent
+    }
+}
