@@ -523,15 +523,13 @@ impl Engine {
     }
 
     /// Calls `visit(mode, energy)` for every mode sounding in a voice (the input voice
-    /// included), with its squared amplitude `|z|^2`; a mode sounding in several voices is
-    /// visited once per voice. Modes are numbered as in [`PreparedBank`] (ascending frequency).
+    /// included), computed or switched off by pruning, with its squared amplitude `|z|^2`; a
+    /// mode sounding in several voices is visited once per voice. Modes are numbered as in [`PreparedBank`] (ascending frequency).
     /// Modes never visited are silent everywhere: truncated, not struck, or above the highest
     /// frequency played. For meters: does not allocate.
     pub fn visit_mode_energies(&self, mut visit: impl FnMut(usize, f32)) {
         for v in self.voices.iter().chain(self.input_voice.as_ref()) {
-            for (mode, energy) in v.modes.live_energies() {
-                visit(mode, energy);
-            }
+            v.modes.visit_energies(&mut visit);
         }
     }
 

@@ -419,13 +419,45 @@ impl ResonatorBank {
         computed + dormant
     }
 
-    /// Each live mode with its squared amplitude `|z|^2`, in slot order. For meters: it reads the
-    /// state and changes nothing.
-    pub fn live_energies(&self) -> impl Iterator<Item = (usize, f32)> + '_ {
-        self.live_slots().map(|s| {
-            let mode = self.mode_of_slot[s] as usize;
-            (mode, self.re[s] * self.re[s] + self.im[s] * self.im[s])
-        })
+    /// Calls `visit(mode, |z|^2)` for every live mode, computed or dormant, with the power of its
+    /// true state: a mode fading out as its record carries it, a mode fading in as it will be
+    /// when the fade ends, a ghost's ringing added to its mode's. For meters: reads the state and
+    /// changes nothing.
+    pub fn visit_energies(&self, mut visit: impl FnMut(usize, f32)) {
+        for slot in self.live_slots() {
+            let entry = self.mode_of_slot[slot];
+            // Ghosts join their modes; a mode fading out is visited through its record.
+            if entry & GHOST != 0 || self.fade_delta[slot] > 0.0 {
+                continue;
+            }
+            let mode = entry as usize;
+            let (mut re, mut im) = self.true_state(slot);
+            let ghost = self.ghost_of_mode[mode];
+            if ghost != NONE {
+                // The phasor is linear: the old ringing adds to the new.
+                let (g_re, g_im) = self.true_state(ghost as usize);
+                re += g_re;
+                im += g_im;
+            }
+            visit(mode, re * re + im * im);
+        }
+        let now = self.clock;
+        for d in &self.dormant[..self.num_dormant] {
+            visit(d.mode as usize, d.power_at(now));
+        }
+    }
+
+    /// The state of a slot without what a fade in still holds back: a slot growing by
+    /// `-fade_delta` per sample meets its true state when the fade ends.
+    fn true_state(&self, slot: usize) -> (f32, f32) {
+        let fade = self.fade_delta[slot];
+        if fade < 0.0 {
+            let left = self.fade_end[slot].saturating_sub(self.clock) as f64;
+            let k = (-fade * left).exp() as f32;
+            (self.re[slot] * k, self.im[slot] * k)
+        } else {
+            (self.re[slot], self.im[slot])
+        }
     }
 
     /// Silences every mode.
