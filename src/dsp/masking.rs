@@ -93,16 +93,24 @@ pub fn unmask_delay_samples(
     if margin_db <= 0.0 {
         return 0.0;
     }
-    let spread = if probe_bark > masker_bark && upper_slope_db_per_bark(masker_db) > 0.0 {
-        1.0 + UPPER_SLOPE_PER_DB * (probe_bark - masker_bark)
-    } else {
-        1.0
-    };
+    let spread = curve_spread(masker_bark, masker_db, probe_bark);
     let closing_db_per_sample = masker_fall_db_per_sample * spread - probe_fall_db_per_sample;
     if closing_db_per_sample > 0.0 {
         margin_db / closing_db_per_sample
     } else {
         f32::INFINITY
+    }
+}
+
+/// How many dB a masking curve falls at `probe_bark` per dB its masker at `masker_bark` and
+/// `masker_db` falls: 1 below the masker; above it also the upper slope steepening as the masker
+/// fades (`s_u = 22 - L_m / 5`, seed 001 eq. 4).
+#[inline]
+pub fn curve_spread(masker_bark: f32, masker_db: f32, probe_bark: f32) -> f32 {
+    if probe_bark > masker_bark && upper_slope_db_per_bark(masker_db) > 0.0 {
+        1.0 + UPPER_SLOPE_PER_DB * (probe_bark - masker_bark)
+    } else {
+        1.0
     }
 }
 

@@ -66,7 +66,7 @@ fn prefix_sums(counts: &mut [u32; 256]) {
 const LANES: usize = 8;
 
 /// Scratch storage for the masking pass.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub struct MaskingPass {
     /// Sort key of each candidate: its level quantised, loudest first.
     keys: Vec<u16>,
@@ -82,10 +82,16 @@ pub struct MaskingPass {
     masker_upper_slope: Vec<f32>,
     /// Candidate index of each masker.
     masker_index: Vec<u32>,
-    /// Scratch: each masker's curve at the candidate in hand.
-    curve: Vec<f32>,
     /// Number of maskers found by the last run.
     num_maskers: usize,
+    /// Whether the CPU runs AVX2 and FMA (the envelope is evaluated eight lanes wide).
+    avx2: bool,
+}
+
+impl Default for MaskingPass {
+    fn default() -> Self {
+        Self::with_capacity(0)
+    }
 }
 
 impl MaskingPass {
@@ -100,8 +106,8 @@ impl MaskingPass {
             masker_peak: vec![f32::NEG_INFINITY; padded],
             masker_upper_slope: vec![0.0; padded],
             masker_index: vec![0; capacity],
-            curve: vec![f32::NEG_INFINITY; padded],
             num_maskers: 0,
+            avx2: crate::dsp::Kernel::Avx2.is_supported(),
         }
     }
 
@@ -198,13 +204,8 @@ impl MaskingPass {
                 out[i] = envelope.max(threshold_db[i]);
             }
             verdicts[i] = if l < envelope {
-                // The masker whose curve is highest here.
-                let j = self.curve[..self.num_maskers]
-                    .iter()
-                    .position(|&c| c == envelope)
-                    .unwrap_or(0);
                 Verdict::Masked {
-                    by: self.masker_index[j],
+                    by: self.masker_index[self.masker_above(b, l)],
                 }
             } else if !loudest && l < envelope.max(threshold_db[i]) + offset_db {
                 // Close to a masker's curve, or to the threshold in quiet (the seed's curve
@@ -253,32 +254,33 @@ impl MaskingPass {
     }
 
     /// Upper envelope of the maskers' curves at `bark` (seed 001 eq. 4 without the threshold in
-    /// quiet, which the caller has already applied). Leaves each masker's curve there in
-    /// `curve`.
+    /// quiet, which the caller has already applied): every masker at once, eight lanes at a
+    /// time, with AVX2 when the CPU has it.
     #[inline]
-    fn envelope_at(&mut self, bark: f32) -> f32 {
+    fn envelope_at(&self, bark: f32) -> f32 {
         let used = self.num_maskers.div_ceil(LANES) * LANES;
-        for (((c, mb), peak), su) in self.curve[..used]
-            .iter_mut()
-            .zip(&self.masker_bark[..used])
-            .zip(&self.masker_peak[..used])
-            .zip(&self.masker_upper_slope[..used])
-        {
-            let below = LOWER_SLOPE_DB_PER_BARK * (mb - bark);
-            let above = su * (bark - mb);
-            *c = peak - if below > above { below } else { above };
+        let (mb, peak, su) = (
+            &self.masker_bark[..used],
+            &self.masker_peak[..used],
+            &self.masker_upper_slope[..used],
+        );
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is only set when the CPU supports AVX2 and FMA.
+            return unsafe { envelope_avx2(mb, peak, su, bark) };
         }
-        let mut lanes = [f32::NEG_INFINITY; LANES];
-        for chunk in self.curve[..used].chunks_exact(LANES) {
-            for l in 0..LANES {
-                lanes[l] = if chunk[l] > lanes[l] {
-                    chunk[l]
-                } else {
-                    lanes[l]
-                };
-            }
-        }
-        lanes.into_iter().fold(f32::NEG_INFINITY, f32::max)
+        envelope(mb, peak, su, bark)
+    }
+
+    /// The first masker (loudest first) whose curve at `bark` reaches `level_db`.
+    fn masker_above(&self, bark: f32, level_db: f32) -> usize {
+        (0..self.num_maskers)
+            .find(|&j| {
+                let below = LOWER_SLOPE_DB_PER_BARK * (self.masker_bark[j] - bark);
+                let above = self.masker_upper_slope[j] * (bark - self.masker_bark[j]);
+                self.masker_peak[j] - below.max(above) > level_db
+            })
+            .unwrap_or(0)
     }
 
     fn push_masker(&mut self, index: usize, bark: f32, level_db: f32, offset_db: f32) {
@@ -289,6 +291,36 @@ impl MaskingPass {
         self.masker_index[j] = index as u32;
         self.num_maskers += 1;
     }
+}
+
+/// The envelope of masking curves given as parallel lanes (a whole number of [`LANES`]): bark,
+/// peak `L - a_v` and upper slope of each masker.
+#[inline(always)]
+fn envelope(masker_bark: &[f32], peak: &[f32], upper_slope: &[f32], bark: f32) -> f32 {
+    let mut best = [f32::NEG_INFINITY; LANES];
+    for ((mb, pk), su) in masker_bark
+        .chunks_exact(LANES)
+        .zip(peak.chunks_exact(LANES))
+        .zip(upper_slope.chunks_exact(LANES))
+    {
+        for l in 0..LANES {
+            let below = LOWER_SLOPE_DB_PER_BARK * (mb[l] - bark);
+            let above = su[l] * (bark - mb[l]);
+            let curve = pk[l] - if below > above { below } else { above };
+            best[l] = if curve > best[l] { curve } else { best[l] };
+        }
+    }
+    best.into_iter().fold(f32::NEG_INFINITY, f32::max)
+}
+
+/// [`envelope`] compiled for AVX2 and FMA.
+///
+/// # Safety
+/// The CPU must support AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn envelope_avx2(masker_bark: &[f32], peak: &[f32], upper_slope: &[f32], bark: f32) -> f32 {
+    envelope(masker_bark, peak, upper_slope, bark)
 }
 
 /// Reorders `ranked` so that its first `keep` entries are those with the most energy (the first

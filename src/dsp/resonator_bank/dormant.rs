@@ -21,7 +21,7 @@
 
 use std::f64::consts::{PI, TAU};
 
-use super::{ModeCoeffs, ResonatorBank, COLUMNS, GHOST, NONE};
+use super::{ModeCoeffs, PulseShape, ResonatorBank, COLUMNS, GHOST, NONE};
 use crate::dsp::coeffs_batch::{cos_series, sin_series};
 use crate::dsp::masking::{power_to_db, DB_PER_NEPER};
 
@@ -62,6 +62,10 @@ pub(super) struct Dormant {
     pub p_im: f64,
     /// The pruner's note about what keeps the mode off (its masker).
     pub tag: u32,
+    /// This pole's response to a unit pulse of `response_len` samples of `response_shape`,
+    /// referred to the sample before the pulse (`None` until a strike asks for it): strikes on
+    /// an object usually repeat their mallet.
+    pub response: Option<(PulseShape, u32, f64, f64)>,
 }
 
 impl Dormant {
@@ -82,6 +86,7 @@ impl Dormant {
         p_re: 1.0,
         p_im: 0.0,
         tag: 0,
+        response: None,
     };
 
     /// Takes a new pole from now on (after [`Dormant::advance_to`]).
@@ -90,6 +95,7 @@ impl Dormant {
             (self.theta, self.delta) = (theta, delta);
             let c = ModeCoeffs::from_angle_radius(theta, delta);
             (self.p_re, self.p_im) = (1.0 + c.q_re as f64, c.q_im as f64);
+            self.response = None;
         }
     }
 
@@ -150,7 +156,7 @@ pub struct ActiveMode {
 }
 
 /// A dormant mode, as the pruner sees it.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 pub struct DormantMode {
     /// The mode.
     pub mode: usize,
@@ -199,7 +205,17 @@ impl ResonatorBank {
     }
 
     /// Calls `f` for every computed mode (not ghosts).
-    pub fn for_each_active(&self, mut f: impl FnMut(ActiveMode)) {
+    pub fn for_each_active(&self, f: impl FnMut(ActiveMode)) {
+        self.for_each_active_where(|_, _| true, f);
+    }
+
+    /// Calls `f` for every computed mode (not ghosts) for which `wanted(mode, fading)` holds;
+    /// the others cost a look at their slot only.
+    pub fn for_each_active_where(
+        &self,
+        mut wanted: impl FnMut(usize, bool) -> bool,
+        mut f: impl FnMut(ActiveMode),
+    ) {
         let now = self.clock;
         for c in 0..COLUMNS {
             for r in 0..self.live[c] as usize {
@@ -210,6 +226,10 @@ impl ResonatorBank {
                 }
                 let mode = entry as usize;
                 let fade = self.fade_delta[slot];
+                let has_ghost = self.ghost_of_mode[mode] != NONE;
+                if !wanted(mode, fade != 0.0 || has_ghost) {
+                    continue;
+                }
                 let mut power = if fade > 0.0 {
                     self.dormant[self.dormant_of_mode[mode] as usize].power_at(now)
                 } else {
@@ -283,6 +303,16 @@ impl ResonatorBank {
         }
     }
 
+    /// Moves the time the pruner next looks at dormant `mode` to `recheck_at` (bank clock),
+    /// keeping its note.
+    pub fn set_recheck_time(&mut self, mode: usize, recheck_at: u64) {
+        let r = self.dormant_of_mode[mode];
+        if r != NONE {
+            self.recheck[r as usize] = recheck_at;
+            self.earliest_recheck = self.earliest_recheck.min(recheck_at);
+        }
+    }
+
     /// Starts fading computed `mode` out over `fade_samples`; from then on it is carried
     /// analytically. Modes already fading, or with a ghost, are left alone.
     pub fn switch_off(&mut self, mode: usize, fade_samples: u32, recheck_at: u64, tag: u32) {
@@ -313,6 +343,7 @@ impl ResonatorBank {
                 p_re: 1.0 + self.q_re[slot] as f64,
                 p_im: self.q_im[slot] as f64,
                 tag,
+                response: None,
             },
             recheck_at,
         );

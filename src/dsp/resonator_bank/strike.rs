@@ -133,7 +133,8 @@ impl ResonatorBank {
     /// Every dormant mode (none may be fading: see [`ResonatorBank::wake_fading`]) takes `pulse`,
     /// starting at the next sample, with input gain `gain_of(mode)`, without being computed. With
     /// `due`, each is due for another look by the pruner now; otherwise its recheck time stands
-    /// (the pruner has set it knowing the strike).
+    /// until the pruner sets another from the strike's outcome. A mode the pruner then wakes
+    /// ([`ResonatorBank::wake`]) computes the strike from its first sample.
     pub fn absorb_strike(
         &mut self,
         pulse: Pulse,
@@ -159,7 +160,12 @@ impl ResonatorBank {
         }
         self.pulses[kept] = (now, pulse);
         self.num_pulses = kept + 1;
-        let prepared = pulse.prepared();
+        let unit = Pulse {
+            amplitude: 1.0,
+            ..pulse
+        };
+        let prepared = unit.prepared();
+        let key = (pulse.shape, unit.samples());
         for r in 0..self.num_dormant {
             let d = &mut self.dormant[r];
             if self.slot_of_mode[d.mode as usize] != NONE {
@@ -168,8 +174,16 @@ impl ResonatorBank {
             d.advance_to(now);
             let (re, im) = d.state();
             let gain = gain_of(d.mode as usize);
-            let added = prepared.response(C::new(d.p_re, d.p_im), 0, u32::MAX);
-            let z = C::new(re as f64, im as f64).add(added.scale(gain as f64));
+            let response = match d.response {
+                Some((shape, len, re, im)) if (shape, len) == key => C::new(re, im),
+                _ => {
+                    let r = prepared.response(C::new(d.p_re, d.p_im), 0, u32::MAX);
+                    d.response = Some((key.0, key.1, r.re, r.im));
+                    r
+                }
+            };
+            let added = response.scale(pulse.amplitude as f64 * gain as f64);
+            let z = C::new(re as f64, im as f64).add(added);
             let (re, im) = (z.re as f32, z.im as f32);
             d.re = re;
             d.im = im;
