@@ -431,7 +431,7 @@ impl Engine {
             .max(1.0) as u32;
         let threshold = db_to_gain(c.truncation_db);
         let kind = c.exciter;
-        let pulse = self.wake_for_strike(i, kind, amplitude, len, &weights);
+        let dormant = self.prepare_strike(i, kind);
         self.voices[i].strike(
             &self.bank,
             &self.decay,
@@ -443,7 +443,9 @@ impl Engine {
             len,
             threshold,
         );
-        self.settle_strike(i, pulse, &weights);
+        if dormant {
+            self.settle_strike(i, kind, amplitude, len, &weights);
+        }
     }
 
     /// Renders a run of samples within one control period and with no events inside.

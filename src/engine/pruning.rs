@@ -34,9 +34,10 @@ mod strike;
 use std::time::Instant;
 
 use super::voice::{Tuning, Voice, VoiceState};
+use crate::dsp::resonator_bank::DormantMode;
 use super::{Engine, CONTROL_PERIOD};
 use crate::dsp::coeffs::gain_to_db;
-use crate::dsp::masking::unmask_delay_samples;
+use crate::dsp::masking::{curve_spread, unmask_delay_samples};
 use crate::dsp::pruning::{keep_most_energetic, MaskingPass, Verdict, PRIOR};
 use candidates::{Candidates, Reading, DORMANT, DROP, LOCKED, OVER_BUDGET};
 use maskers::Maskers;
@@ -151,6 +152,15 @@ pub(super) struct Pruner {
     truncation_db: Vec<f32>,
     /// Engine clock before which a heard mode need not be looked at again (voice-major).
     heard_until: Vec<u64>,
+    /// Why each dormant mode is off (voice-major), so a strike can tell at once which it lifts
+    /// into hearing.
+    off: Vec<OffReason>,
+    /// Scratch: the dormant modes of a struck voice.
+    dormant_scratch: Vec<DormantMode>,
+    /// Scratch: new recheck times `(mode, bank clock)` a strike sets.
+    rechecks: Vec<(u32, u64)>,
+    /// Number of `rechecks` in use.
+    num_rechecks: usize,
     /// Analyses since every mode was last looked at.
     since_full: u32,
     /// Whether modes may be dormant or fading somewhere.
@@ -184,6 +194,10 @@ impl Pruner {
             struck: Vec::new(),
             truncation_db: Vec::new(),
             heard_until: Vec::new(),
+            off: Vec::new(),
+            dormant_scratch: Vec::new(),
+            rechecks: Vec::new(),
+            num_rechecks: 0,
             since_full: 0,
             engaged: false,
             pending: false,
@@ -211,6 +225,9 @@ impl Pruner {
         self.struck = vec![false; num_voices];
         self.truncation_db = vec![0.0; num_voices];
         self.heard_until = vec![0; n];
+        self.off = vec![OffReason::UNKNOWN; n];
+        self.rechecks = vec![(0, 0); num_modes];
+        self.dormant_scratch = vec![DormantMode::default(); num_modes];
         self.forget();
     }
 
@@ -254,18 +271,18 @@ impl Pruner {
 
 impl Pruner {
     /// For candidate `i`, found inaudible, masked or over the budget: how long (in samples) until
-    /// it could be heard again, and the tag naming its masker's voice.
-    fn when_off(&self, i: usize, offset_db: f32) -> (u64, u32) {
+    /// it could be heard again, the tag naming its masker's voice, and what keeps it off.
+    fn when_off(&self, i: usize, offset_db: f32, now: u64) -> (u64, u32, OffReason) {
         let cd = &self.cands;
         let (vi, _) = cd.voice_mode(i);
         let to_truncation = samples_to_cross(cd.raw_db[i] - self.truncation_db[vi], cd.fall_db[i]);
         if cd.flags[i] & OVER_BUDGET != 0 {
-            // Over budget: look again next frame.
-            return (0, NO_TAG);
+            // Over budget: look again next frame; a strike leaves it to that look.
+            return (0, NO_TAG, OffReason::BUDGET);
         }
         match cd.verdicts[i] {
             Verdict::Masked { by } => {
-                let (bark, level, fall, voice, generation) = if by & PRIOR != 0 {
+                let (bark, level, fall, who, generation) = if by & PRIOR != 0 {
                     let jj = (by & !PRIOR) as usize;
                     let j = self.prior_entry[jj] as usize;
                     let m = &self.maskers;
@@ -273,7 +290,7 @@ impl Pruner {
                         m.bark[j],
                         self.prior_level_db[jj],
                         m.fall_db[j],
-                        m.who[j] >> 24,
+                        m.who[j],
                         m.generation[j],
                     )
                 } else {
@@ -283,10 +300,11 @@ impl Pruner {
                         cd.bark[j],
                         cd.level_db[j],
                         cd.fall_db[j],
-                        voice,
+                        cd.who[j],
                         self.generation[voice as usize],
                     )
                 };
+                let voice = who >> 24;
                 let delay = unmask_delay_samples(
                     bark,
                     level,
@@ -297,12 +315,80 @@ impl Pruner {
                     cd.fall_db[i],
                 );
                 let delay = (delay.clamp(0.0, 1e15) as u64).min(to_truncation);
-                (delay, (voice << 24) | generation)
+                let reason = OffReason {
+                    // The envelope of every masker's curve: the masker named is one under it.
+                    curve_db: cd.envelope_db[i],
+                    fall_db: fall * curve_spread(bark, level, cd.bark[i]),
+                    at: now,
+                    threshold_db: cd.threshold_db[i],
+                    generation: self.generation[vi],
+                    masker: if voice as usize == vi {
+                        who & candidates::MODE_MASK
+                    } else {
+                        u32::MAX
+                    },
+                };
+                (delay, (voice << 24) | generation, reason)
             }
-            // Below the threshold of hearing it only gets quieter.
-            Verdict::Inaudible => (to_truncation, NO_TAG),
-            Verdict::Audible { .. } => (0, NO_TAG),
+            // Below the threshold of hearing it only gets quieter, unless struck.
+            Verdict::Inaudible => (
+                to_truncation,
+                NO_TAG,
+                OffReason {
+                    curve_db: f32::NEG_INFINITY,
+                    fall_db: 0.0,
+                    at: now,
+                    threshold_db: cd.threshold_db[i],
+                    generation: self.generation[vi],
+                    masker: u32::MAX,
+                },
+            ),
+            Verdict::Audible { .. } => (0, NO_TAG, OffReason::UNKNOWN),
         }
+    }
+}
+
+/// What keeps a dormant mode off: the masking curve over it (falling as its masker decays) and
+/// the threshold in quiet, in dB SPL. A strike that leaves the mode under both leaves it off.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct OffReason {
+    /// The masking curve at the mode at engine clock `at`, dB SPL.
+    curve_db: f32,
+    /// How fast the curve falls there, dB per sample.
+    fall_db: f32,
+    /// Engine clock of `curve_db`.
+    at: u64,
+    /// The threshold in quiet at the mode, dB SPL.
+    threshold_db: f32,
+    /// The generation of the mode's voice when judged: a retuned voice has it judged again.
+    generation: u32,
+    /// The mode whose masking curve it lies under, when that mode is in the same voice (a
+    /// strike lifts both), else `u32::MAX`.
+    masker: u32,
+}
+
+impl OffReason {
+    /// Nothing known: a strike has the mode judged again.
+    const UNKNOWN: Self = Self {
+        curve_db: f32::NEG_INFINITY,
+        fall_db: 0.0,
+        at: 0,
+        threshold_db: f32::NEG_INFINITY,
+        generation: u32::MAX,
+        masker: u32::MAX,
+    };
+
+    /// Off for the budget: a strike leaves it to the next analysis.
+    const BUDGET: Self = Self {
+        curve_db: f32::INFINITY,
+        threshold_db: f32::INFINITY,
+        ..Self::UNKNOWN
+    };
+
+    /// The level in dB SPL a mode must reach at engine clock `now` to be heard.
+    fn level_to_beat(&self, now: u64) -> f32 {
+        let curve = self.curve_db - self.fall_db * now.saturating_sub(self.at) as f32;
+        curve.max(self.threshold_db)
     }
 }
 
@@ -416,11 +502,11 @@ impl Engine {
             p.truncation_db[vi] = truncation_db;
             let generation = p.generation[vi];
             let (cands, heard_until) = (&mut p.cands, &p.heard_until);
-            v.modes.for_each_active(|m| {
+            let wanted = |mode: usize, fading: bool| {
+                every_active || fading || driven || heard_until[vi * stride + mode] <= now
+            };
+            v.modes.for_each_active_where(wanted, |m| {
                 let locked = m.fading || driven;
-                if !(every_active || locked || heard_until[vi * stride + m.mode] <= now) {
-                    return;
-                }
                 let power = if driven {
                     let amplitude = m.power.sqrt() + m.gain.abs() * pulse;
                     amplitude * amplitude
@@ -552,7 +638,8 @@ impl Engine {
                 continue;
             }
             // Off: when to look again, and what to watch.
-            let (delay, tag) = p.when_off(i, c.masking_offset_db);
+            let (delay, tag, reason) = p.when_off(i, c.masking_offset_db, now);
+            p.off[vi * stride + mode] = reason;
             let recheck_at = bank.clock() + delay;
             if f & DORMANT != 0 {
                 bank.set_recheck(mode, recheck_at, tag);

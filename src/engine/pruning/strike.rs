@@ -1,97 +1,84 @@
 //! A strike on a voice with dormant modes.
 //!
 //! The strike is known in full when it comes (an impulse or a mallet pulse of known area and
-//! length), so the masking pass can judge the struck voice's modes at once: each mode's level is
-//! bounded by its amplitude now plus what the strike can add (`|g| A`), against the masking
-//! curves of the maskers carried over from the last analysis and of the voice's own louder modes.
-//! Dormant modes the strike makes audible are woken at its exact sample, and take it computed
-//! (their old ringing fading back in beside them); the others take it analytically
-//! ([`crate::dsp::ResonatorBank::absorb_strike`]) and stay dormant. A noise burst is not known in
-//! advance: it wakes them all.
+//! length), so every dormant mode of the struck voice takes it analytically
+//! ([`crate::dsp::ResonatorBank::absorb_strike`]) and its level afterwards is known exactly. Most
+//! stay under what kept them off (the masking curve over them, falling as its masker decays, or
+//! the threshold in quiet), and stay dormant: a comparison each. The few lifted above it are
+//! judged by the masking pass, against the maskers carried over from the last analysis and the
+//! voice's own computed modes as the strike leaves them; those found audible are woken at the
+//! strike's exact sample and compute it from its first sample, their old ringing fading back in
+//! beside them. A noise burst is not known in advance: it wakes them all.
 
 use std::time::Instant;
 
 use super::candidates::{Reading, DORMANT};
-use super::Engine;
+use super::{samples_to_cross, OffReason, NO_TAG};
 use crate::dsp::masking::{power_to_db, DB_PER_NEPER};
 use crate::dsp::resonator_bank::{Pulse, PulseShape};
 use crate::dsp::ExciterKind;
-use crate::engine::PositionWeights;
+use crate::engine::{Engine, PositionWeights};
 
 impl Engine {
-    /// Before voice `i` is struck by `kind` of `amplitude` over `len` samples at strike point
-    /// `weights`: wakes the dormant modes the strike makes audible (all of them for noise).
-    /// Returns the pulse the other dormant modes are to take, with
-    /// [`Engine::settle_strike`] once the voice has been struck.
-    pub(in crate::engine) fn wake_for_strike(
+    /// Before voice `i` is struck by `kind`: modes fading in or out are woken (through their
+    /// poles they cannot take input), and every dormant one too for noise. Returns the shape the
+    /// dormant modes are to take analytically with [`Engine::settle_strike`], if any remain.
+    pub(in crate::engine) fn prepare_strike(&mut self, i: usize, kind: ExciterKind) -> bool {
+        self.pruner.struck[i] = true;
+        let modes = &mut self.voices[i].modes;
+        if modes.num_dormant() + modes.num_fading() == 0 {
+            return false;
+        }
+        let start = self.pruner.profiling.then(Instant::now);
+        match kind {
+            ExciterKind::Impulse | ExciterKind::Mallet => modes.wake_fading(),
+            ExciterKind::Noise => modes.wake_all(),
+        }
+        if let Some(start) = start {
+            self.pruner.stats.strike_ns += start.elapsed().as_nanos() as u64;
+        }
+        modes.num_dormant() > 0
+    }
+
+    /// After voice `i` has been struck by `kind` of `amplitude` over `len` samples at strike
+    /// point `weights`: its dormant modes take the pulse analytically, and those it makes
+    /// audible are woken.
+    pub(in crate::engine) fn settle_strike(
         &mut self,
         i: usize,
         kind: ExciterKind,
         amplitude: f32,
         len: u32,
         weights: &PositionWeights,
-    ) -> Option<Pulse> {
-        self.pruner.struck[i] = true;
-        let modes = &self.voices[i].modes;
-        if modes.num_dormant() + modes.num_fading() == 0 {
-            return None;
-        }
-        let start = self.pruner.profiling.then(Instant::now);
-        let shape = match kind {
-            ExciterKind::Impulse => Some(PulseShape::Impulse),
-            ExciterKind::Mallet => Some(PulseShape::Mallet),
-            ExciterKind::Noise => None,
-        };
-        let pulse = match shape {
-            Some(shape) => {
-                // Modes fading in or out cannot take input through their poles.
-                self.voices[i].modes.wake_fading();
-                if self.voices[i].modes.num_dormant() > 0 {
-                    self.wake_audible(i, amplitude * kind.peak_bound(len), weights);
-                }
-                Some(Pulse {
-                    shape,
-                    amplitude,
-                    len,
-                })
-            }
-            None => {
-                self.voices[i].modes.wake_all();
-                None
-            }
-        };
-        if let Some(start) = start {
-            self.pruner.stats.strike_ns += start.elapsed().as_nanos() as u64;
-        }
-        pulse.filter(|_| self.voices[i].modes.num_dormant() > 0)
-    }
-
-    /// After voice `i` has been struck: its dormant modes take `pulse` at strike point `weights`.
-    pub(in crate::engine) fn settle_strike(
-        &mut self,
-        i: usize,
-        pulse: Option<Pulse>,
-        weights: &PositionWeights,
     ) {
-        let Some(pulse) = pulse else {
-            return;
+        let shape = match kind {
+            ExciterKind::Impulse => PulseShape::Impulse,
+            ExciterKind::Mallet => PulseShape::Mallet,
+            ExciterKind::Noise => return,
         };
         let start = self.pruner.profiling.then(Instant::now);
+        let pulse = Pulse {
+            shape,
+            amplitude,
+            len,
+        };
         let bank = &self.bank;
         let modes = &mut self.voices[i].modes;
         self.pruner.stats.absorbed += modes.num_dormant() as u64;
-        // With pruning the strike's verdicts have set when to look again; a budget alone looks
-        // at the next frame.
-        let due = !self.controls.pruning;
-        modes.absorb_strike(pulse, due, |m| bank.gain_at(m, weights));
+        // With pruning the modes are judged below; a budget alone looks at the next frame.
+        let pruning = self.controls.pruning;
+        modes.absorb_strike(pulse, !pruning, |m| bank.gain_at(m, weights));
+        if pruning {
+            self.judge_struck(i, amplitude * kind.peak_bound(len), weights);
+        }
         if let Some(start) = start {
             self.pruner.stats.strike_ns += start.elapsed().as_nanos() as u64;
         }
     }
 
-    /// Runs the masking pass over voice `i` as it will be after a strike adding up to `bound`
-    /// times each mode's gain at `weights`, and wakes the dormant modes it finds audible.
-    fn wake_audible(&mut self, i: usize, bound: f32, weights: &PositionWeights) {
+    /// Wakes the dormant modes of voice `i` that a strike adding up to `bound` times each
+    /// mode's gain at `weights` (already taken by the dormant modes) makes audible.
+    fn judge_struck(&mut self, i: usize, bound: f32, weights: &PositionWeights) {
         let calibration_db = self.calibration_db();
         let Engine {
             pruner: p,
@@ -102,16 +89,85 @@ impl Engine {
             bank,
             ..
         } = self;
-        if !c.pruning {
-            // Only a budget: the next analysis brings back what fits.
-            return;
-        }
+        let now = *clock;
         let reading = Reading::new(calibration_db, *sample_rate_hz, false);
         let generation = p.generation[i];
-        p.truncation_db[i] =
-            c.truncation_db - 10.0 * (voices[i].modes.num_started().max(1) as f32).log10();
-        let cands = &mut p.cands;
+        let stride = p.cands.stride;
         let modes = &mut voices[i].modes;
+        let bank_now = modes.clock();
+        // Each dormant mode against what kept it off; those lifted above it are judged again.
+        let mut num_dormant = 0;
+        let scratch = &mut p.dormant_scratch;
+        modes.for_each_dormant(u64::MAX, |d| {
+            scratch[num_dormant] = d;
+            num_dormant += 1;
+        });
+        p.num_rechecks = 0;
+        for d in &p.dormant_scratch[..num_dormant] {
+            let reason = p.off[i * stride + d.mode];
+            if reason == OffReason::BUDGET {
+                p.rechecks[p.num_rechecks] = (d.mode as u32, bank_now);
+                p.num_rechecks += 1;
+                continue;
+            }
+            let stale_tag = d.tag != NO_TAG && {
+                let masker = (d.tag >> 24) as usize;
+                p.generation
+                    .get(masker)
+                    .is_none_or(|&g| g != d.tag & super::GENERATION_MASK)
+            };
+            let level_db = d.level_db + calibration_db;
+            // A masker in this voice takes the strike too: its curve rises with it (a masker
+            // no longer computed is not known, and the mode is judged again).
+            let lift_db = if reason.masker == u32::MAX {
+                0.0
+            } else {
+                let masker = reason.masker as usize;
+                match modes.state(masker) {
+                    Some((re, im)) => {
+                        let a = (re * re + im * im).sqrt();
+                        let lifted = a + bank.gain_at(masker, weights).abs() * bound;
+                        power_to_db(lifted * lifted) - power_to_db(a * a)
+                    }
+                    None => f32::NEG_INFINITY,
+                }
+            };
+            let to_beat = reason.level_to_beat(now) + lift_db;
+            if reason.generation == generation && !stale_tag && level_db < to_beat {
+                // Still off: it surfaces no sooner than its margin under the curve allows.
+                let curve = reason.curve_db - reason.fall_db * (now - reason.at) as f32 + lift_db;
+                let fall = DB_PER_NEPER * d.delta as f32;
+                let closing = reason.fall_db - fall;
+                if curve > reason.threshold_db && closing > 0.0 {
+                    let delay = samples_to_cross(curve - level_db, closing);
+                    let recheck_at = d.recheck_at.min(bank_now + delay);
+                    if recheck_at != d.recheck_at {
+                        p.rechecks[p.num_rechecks] = (d.mode as u32, recheck_at);
+                        p.num_rechecks += 1;
+                    }
+                }
+                continue;
+            }
+            p.cands.push(
+                i,
+                generation,
+                d.mode,
+                d.level_db,
+                d.theta,
+                d.delta,
+                DORMANT,
+                &reading,
+            );
+        }
+        for &(mode, recheck_at) in &p.rechecks[..p.num_rechecks] {
+            modes.set_recheck_time(mode as usize, recheck_at);
+        }
+        let num_dormant = p.cands.len;
+        if num_dormant == 0 {
+            return;
+        }
+        // The voice's computed modes as the strike leaves them, to mask the lifted ones.
+        let cands = &mut p.cands;
         modes.for_each_active(|m| {
             let a = m.power.sqrt() + bank.gain_at(m.mode, weights).abs() * bound;
             cands.push(
@@ -125,22 +181,9 @@ impl Engine {
                 &reading,
             );
         });
-        modes.for_each_dormant(u64::MAX, |d| {
-            let a = (d.level_db / DB_PER_NEPER).exp() + bank.gain_at(d.mode, weights).abs() * bound;
-            cands.push(
-                i,
-                generation,
-                d.mode,
-                power_to_db(a * a),
-                d.theta,
-                d.delta,
-                DORMANT,
-                &reading,
-            );
-        });
         let n = cands.len;
         p.stats.candidates += n as u64;
-        let num_prior = p.gather_priors(*clock, Some(i));
+        let num_prior = p.gather_priors(now, Some(i));
         let cd = &mut p.cands;
         p.pass.run_after(
             &p.prior_bark[..num_prior],
@@ -150,20 +193,15 @@ impl Engine {
             &cd.threshold_db[..n],
             c.masking_offset_db,
             &mut cd.verdicts[..n],
-            None,
+            Some(&mut cd.envelope_db[..n]),
         );
-        let bank_now = modes.clock();
-        for k in 0..n {
-            if p.cands.flags[k] & DORMANT == 0 {
-                continue;
-            }
+        for k in 0..num_dormant {
             let mode = p.cands.voice_mode(k).1;
             if p.cands.verdicts[k].is_audible() {
                 modes.wake(mode);
             } else {
-                // It takes the strike analytically; its level with the strike is at most the
-                // bound judged here, so it is looked at again no later than it has to be.
-                let (delay, tag) = p.when_off(k, c.masking_offset_db);
+                let (delay, tag, reason) = p.when_off(k, c.masking_offset_db, now);
+                p.off[i * stride + mode] = reason;
                 modes.set_recheck(mode, bank_now + delay, tag);
             }
         }
