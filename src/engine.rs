@@ -24,7 +24,9 @@ mod voice;
 use std::sync::Arc;
 
 pub use controls::{
-    ControlSpec, Controls, Material, MATERIAL_Q_RANGE, MAX_POLYPHONY, NUMERIC_CONTROLS,
+    ControlSpec, Controls, Material, ANALYSIS_FRAME_RANGE_MS, MASKING_OFFSET_RANGE_DB,
+    MATERIAL_Q_RANGE, MAX_MODE_BUDGET, MAX_POLYPHONY, MAX_TARGET_LOAD_PCT, NUMERIC_CONTROLS,
+    PLAYBACK_LEVEL_RANGE_DB_SPL,
 };
 pub use position::{PositionMap, PositionWeights};
 pub use prepared::{PreparedBank, TARGET_PEAK};
@@ -391,8 +393,16 @@ impl Engine {
     }
 
     /// Sizes everything for `sample_rate_hz` and resets. Allocates. Blocks of any length can be
-    /// processed afterwards; `_max_block` is accepted for hosts that announce it.
+    /// processed afterwards; `_max_block` is accepted for hosts that announce it. The first
+    /// engine prepared in a process also measures its speed for the automatic budget (a few
+    /// milliseconds): never call it on the audio thread.
     pub fn prepare(&mut self, sample_rate_hz: f32, _max_block: usize) {
+        self.prepare_storage(sample_rate_hz);
+        self.budget.calibrate(self.kernel, self.sample_rate_hz);
+    }
+
+    /// [`Engine::prepare`] without measuring the engine's speed.
+    fn prepare_storage(&mut self, sample_rate_hz: f32) {
         assert!(
             sample_rate_hz.is_finite() && sample_rate_hz >= 8_000.0,
             "sample rate {sample_rate_hz} Hz is not supported"
@@ -403,7 +413,6 @@ impl Engine {
         self.excitation = vec![0.0; CONTROL_PERIOD];
         self.ended = Vec::with_capacity(MAX_ENDED);
         self.allocate_voices();
-        self.budget.calibrate(self.kernel, self.sample_rate_hz);
         self.reset();
     }
 
@@ -489,8 +498,9 @@ impl Engine {
         self.kernel
     }
 
-    /// Uses `kernel` from now on (it must be supported by this CPU), measuring its cost for the
-    /// automatic budget (about a millisecond).
+    /// Uses `kernel` from now on (it must be supported by this CPU), with its cost for the
+    /// automatic budget (measured the first time a kernel is used in this process: a few
+    /// milliseconds, not on the audio thread).
     pub fn set_kernel(&mut self, kernel: Kernel) {
         assert!(
             kernel.is_supported(),
