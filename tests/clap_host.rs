@@ -146,7 +146,8 @@ fn a_bank_loaded_while_playing_takes_over_without_a_gap() {
 const PARAM_IDS: &[&str] = &[
     "mat", "q", "tilt", "size", "keytrk", "fine", "bendrg", "posx", "posy", "posvar", "exc",
     "hard", "velsns", "velhrd", "reldmp", "trunc", "poly", "width", "gain", "inmode", "ingain",
-    "trigth", "retrig", "mix", "modwhl", "press", "mpe", "mpebnd",
+    "trigth", "retrig", "mix", "modwhl", "press", "mpe", "mpebnd", "prune", "maskav", "spl",
+    "prfrm", "budget", "load",
 ];
 
 #[test]

@@ -100,6 +100,17 @@ fn groups(p: &ModalParams, is_effect: bool) -> Vec<(&'static str, Vec<Control<'_
                 Float(&p.mpe_bend_range),
             ],
         ),
+        (
+            "Pruning",
+            vec![
+                Bool(&p.pruning),
+                Float(&p.masking_offset),
+                Float(&p.playback_level),
+                Float(&p.analysis_frame),
+                Int(&p.mode_budget),
+                Float(&p.target_load),
+            ],
+        ),
         ("Output", output),
         (
             "Input",

@@ -249,15 +249,27 @@ pub const NUMERIC_CONTROLS: &[ControlSpec] = &[
         get: |c| c.pruning as u8 as f32,
         set: |c, v| c.pruning = v >= 0.5,
     },
-    spec!("masking_offset_db", "dB", 0.0, 20.0, masking_offset_db),
+    spec!(
+        "masking_offset_db",
+        "dB",
+        MASKING_OFFSET_RANGE_DB.0,
+        MASKING_OFFSET_RANGE_DB.1,
+        masking_offset_db
+    ),
     spec!(
         "playback_level_db_spl",
         "dB SPL",
-        40.0,
-        120.0,
+        PLAYBACK_LEVEL_RANGE_DB_SPL.0,
+        PLAYBACK_LEVEL_RANGE_DB_SPL.1,
         playback_level_db_spl
     ),
-    spec!("analysis_frame_ms", "ms", 2.0, 100.0, analysis_frame_ms),
+    spec!(
+        "analysis_frame_ms",
+        "ms",
+        ANALYSIS_FRAME_RANGE_MS.0,
+        ANALYSIS_FRAME_RANGE_MS.1,
+        analysis_frame_ms
+    ),
     spec!(
         "mode_budget",
         "modes",
@@ -266,11 +278,31 @@ pub const NUMERIC_CONTROLS: &[ControlSpec] = &[
         mode_budget,
         true
     ),
-    spec!("target_load_pct", "%", 0.0, 100.0, target_load_pct),
+    spec!(
+        "target_load_pct",
+        "%",
+        0.0,
+        MAX_TARGET_LOAD_PCT,
+        target_load_pct
+    ),
 ];
 
-/// Largest fixed mode budget.
-pub const MAX_MODE_BUDGET: usize = 1_000_000;
+/// Range of the masking offset `a_v` in dB (seed 001 found 5 dB transparent, 20 dB the
+/// laboratory figure for tone-on-tone masking).
+pub const MASKING_OFFSET_RANGE_DB: (f32, f32) = (0.0, 20.0);
+
+/// Range of the playback level: dB SPL of a full-scale sine, from quiet listening to loud.
+pub const PLAYBACK_LEVEL_RANGE_DB_SPL: (f32, f32) = (40.0, 120.0);
+
+/// Range of the pruning analysis frame in ms (seed 001: a few ms, the ear's pitch detection
+/// time, to 46 ms, its audio frame).
+pub const ANALYSIS_FRAME_RANGE_MS: (f32, f32) = (2.0, 100.0);
+
+/// Largest fixed mode budget (0 is no cap).
+pub const MAX_MODE_BUDGET: usize = 100_000;
+
+/// Highest target load of the automatic budget, percent of real time (0 is off).
+pub const MAX_TARGET_LOAD_PCT: f32 = 100.0;
 
 /// Range of material Q.
 pub const MATERIAL_Q_RANGE: (f32, f32) = (1.0, 100_000.0);
@@ -356,6 +388,18 @@ impl Controls {
                         names.join(", ")
                     )
                 })?;
+                Ok(())
+            }
+            "pruning" => {
+                self.pruning = match value.to_ascii_lowercase().as_str() {
+                    "on" | "true" | "1" => true,
+                    "off" | "false" | "0" => false,
+                    _ => {
+                        return Err(format!(
+                            "pruning: expected on or off (true, false, 1, 0), found \"{value}\""
+                        ))
+                    }
+                };
                 Ok(())
             }
             "material_q" if value == "authored" => {
