@@ -148,3 +148,59 @@ fn process_never_allocates() {
     let seen = allocations_in(|| drop(std::hint::black_box(vec![1u8; 10])));
     assert!(seen >= 1);
 }
+
+#[test]
+fn pruning_and_the_budget_never_allocate() {
+    let bank = dense_bank(700, 55.0);
+    let mut e = engine(&bank, 48_000.0);
+    let block = 256;
+    let (mut l, mut r) = (vec![0.0f32; block], vec![0.0f32; block]);
+    let input: Vec<f32> = (0..block)
+        .map(|i| ((i * 7919) % 101) as f32 / 101.0 - 0.5)
+        .collect();
+    // Pruning on throughout, its settings moving; budgets fixed and automatic coming and going.
+    let settings: Vec<Controls> = (0..300)
+        .map(|b| {
+            let mut c = e.controls().clone();
+            c.pruning = b % 50 < 45;
+            c.masking_offset_db = [2.5, 5.0, 10.0, 0.0][b / 20 % 4];
+            c.playback_level_db_spl = 60.0 + (b % 7) as f32 * 8.0;
+            c.analysis_frame_ms = [2.0, 20.0, 46.0][b / 30 % 3];
+            c.mode_budget = [0, 40, 300][b / 25 % 3];
+            c.target_load_pct = [0.0, 1.0, 20.0][b / 35 % 3];
+            c.exciter = ExciterKind::ALL[b / 10 % 3];
+            c.output_gain_db = -((b % 5) as f32) * 3.0;
+            c.size_ratio = 1.0 + (b % 9) as f32 * 0.01;
+            c
+        })
+        .collect();
+    let storms: Vec<Vec<NoteEvent>> = (0..300)
+        .map(|b| {
+            (0..6)
+                .map(|i| NoteEvent::on(((i * 41 + b * 13) % block) as u32, (30 + (b * 7 + i * 11) % 60) as u8, ((b + i) % 10) as f32 / 9.0 + 0.05))
+                .collect::<Vec<_>>()
+        })
+        .map(|mut v| {
+            v.sort_by_key(|e| e.time());
+            v
+        })
+        .collect();
+    let mut dormant = 0;
+    let count = allocations_in(|| {
+        for b in 0..300 {
+            e.set_controls(&settings[b]);
+            let events = if b % 3 == 0 { &storms[b][..] } else { &[] };
+            let input = (b % 40 == 7).then_some(&input[..]);
+            e.process(events, input, &mut l, &mut r);
+            let _ = e.take_ended_voices().count();
+            dormant += e.stats().dormant_modes;
+            e.visit_switched_off_modes(|m| dormant += m.min(1));
+            if b == 200 {
+                e.reset();
+            }
+        }
+    });
+    assert_eq!(count, 0, "process allocated or freed {count} times");
+    assert!(dormant > 0, "pruning never switched a mode off");
+    assert!(e.pruning_stats().absorbed > 0, "no strike met a dormant mode");
+}

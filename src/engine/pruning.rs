@@ -694,6 +694,15 @@ impl Engine {
         s
     }
 
+    /// Calls `visit(mode)` for every mode that pruning or the budget has switched off (its
+    /// state carried analytically), once per voice it sounds in; modes numbered as in
+    /// [`crate::engine::PreparedBank`]. Does not allocate.
+    pub fn visit_switched_off_modes(&self, mut visit: impl FnMut(usize)) {
+        for v in self.voices.iter().chain(self.input_voice.as_ref()) {
+            v.modes.dormant_modes().for_each(&mut visit);
+        }
+    }
+
     /// Times the pruning analyses and strikes from now on (reported in [`PruningStats`]); for
     /// benchmarks. Reading the clock does not allocate.
     pub fn set_profiling(&mut self, on: bool) {

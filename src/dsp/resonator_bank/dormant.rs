@@ -183,6 +183,14 @@ impl ResonatorBank {
         self.num_dormant - self.num_fading_out
     }
 
+    /// The modes switched off and carried analytically (not those still fading out).
+    pub fn dormant_modes(&self) -> impl Iterator<Item = usize> + '_ {
+        self.dormant[..self.num_dormant]
+            .iter()
+            .map(|d| d.mode as usize)
+            .filter(|&m| self.slot_of_mode[m] == NONE)
+    }
+
     /// Number of slots fading in or out, ghosts included.
     pub fn num_fading(&self) -> usize {
         self.num_fading

@@ -1,0 +1,317 @@
+//! Perceptual pruning and the mode budget in the engine (seed 001, seed 000 sections 5.5 and
+//! 6.4): which modes a masking analysis switches off, that switching them off and on does not
+//! click and brings them back in phase, and that a budget keeps the modes with the most energy.
+
+mod common;
+
+use common::*;
+use modal_resonator::dsp::ExciterKind;
+use modal_resonator::engine::{Engine, NoteEvent};
+use modal_resonator::model::Bank;
+
+const RATE: f32 = 48_000.0;
+
+/// An engine with impulse strikes at full force, no key tracking and no truncation to speak of,
+/// so each mode's amplitude is its gain, with pruning at masking offset `a_v` 5 dB.
+fn pruned_engine(bank: &Bank) -> Engine {
+    let mut e = engine(bank, RATE);
+    let mut c = e.controls().clone();
+    c.exciter = ExciterKind::Impulse;
+    c.key_tracking = 0.0;
+    c.velocity_sensitivity = 0.0;
+    c.truncation_db = -160.0;
+    c.pruning = true;
+    c.masking_offset_db = 5.0;
+    e.set_controls(&c);
+    e
+}
+
+/// The key that plays the bank at its own pitch.
+fn root(e: &Engine) -> u8 {
+    e.bank().root_key.round() as u8
+}
+
+/// The modes switched off, sorted.
+fn switched_off(e: &Engine) -> Vec<usize> {
+    let mut modes = Vec::new();
+    e.visit_switched_off_modes(|m| modes.push(m));
+    modes.sort();
+    modes
+}
+
+/// The mode of `e`'s prepared bank at `freq_hz`.
+fn mode_at(e: &Engine, freq_hz: f64) -> usize {
+    e.bank()
+        .freq_hz
+        .iter()
+        .position(|&f| (f - freq_hz).abs() < 1e-6)
+        .expect("a mode at that frequency")
+}
+
+/// Renders `seconds` more with no events.
+fn run(e: &mut Engine, seconds: f64) -> Vec<f32> {
+    render(e, &[], seconds, 256).0
+}
+
+/// Renders a strike on the bank's root at time 0 and `seconds` of ringing.
+fn strike(e: &mut Engine, seconds: f64) -> Vec<f32> {
+    let key = root(e);
+    render(e, &[on(0, key, 1.0)], seconds, 256).0
+}
+
+#[test]
+fn a_loud_mode_masks_a_quiet_neighbour_and_not_a_distant_one() {
+    // 1 kHz at full level, and two modes 50 dB below it: one 0.4 Bark above it, under its
+    // masking curve (about 84 - 5 - 2 dB SPL at the default playback level), one at 6 kHz,
+    // 12 Bark above, where the curve has fallen to about 18 dB SPL and the mode plays at 34.
+    let bank = simple_bank(&[
+        (1_000.0, 1.0, 1.0),
+        (1_080.0, 1.0, 0.003),
+        (6_000.0, 1.0, 0.003),
+    ]);
+    let mut e = pruned_engine(&bank);
+    strike(&mut e, 0.1);
+    assert_eq!(switched_off(&e), vec![mode_at(&e, 1_080.0)]);
+    // Without pruning every mode is computed.
+    let mut off = pruned_engine(&bank);
+    let mut c = off.controls().clone();
+    c.pruning = false;
+    off.set_controls(&c);
+    strike(&mut off, 0.1);
+    assert!(switched_off(&off).is_empty());
+}
+
+#[test]
+fn an_isolated_quiet_mode_above_the_threshold_of_hearing_is_kept() {
+    // 200 Hz loud; at 3 kHz a mode 60 dB down (about 24 dB SPL, above Terhardt's threshold of
+    // about -5 dB there and far from the masker); at 9 kHz one 100 dB down (about -16 dB SPL,
+    // under the threshold of about 7 dB there).
+    let bank = simple_bank(&[
+        (200.0, 1.0, 1.0),
+        (3_000.0, 1.0, 1e-3),
+        (9_000.0, 1.0, 1e-5),
+    ]);
+    let mut e = pruned_engine(&bank);
+    strike(&mut e, 0.1);
+    let off = switched_off(&e);
+    assert!(
+        !off.contains(&mode_at(&e, 3_000.0)),
+        "the quiet isolated mode was pruned: {off:?}"
+    );
+    assert!(
+        off.contains(&mode_at(&e, 9_000.0)),
+        "the mode under the threshold of hearing was kept: {off:?}"
+    );
+    assert!(!off.contains(&mode_at(&e, 200.0)));
+}
+
+#[test]
+fn pruning_never_removes_the_loudest_mode() {
+    // Quiet playback and a quiet bank: every mode is under the threshold of hearing.
+    let bank = simple_bank(&[(300.0, 1.0, 0.2), (700.0, 1.0, 1.0), (2_500.0, 1.0, 0.5)]);
+    let mut e = pruned_engine(&bank);
+    let mut c = e.controls().clone();
+    c.playback_level_db_spl = 40.0;
+    c.output_gain_db = -60.0;
+    e.set_controls(&c);
+    let out = strike(&mut e, 0.2);
+    let loudest = mode_at(&e, 700.0);
+    let off = switched_off(&e);
+    assert_eq!(off.len(), 2, "switched off: {off:?}");
+    assert!(!off.contains(&loudest), "the loudest mode was pruned");
+    assert!(peak(&out[out.len() - 480..]) > 0.0, "the object fell silent");
+}
+
+/// A loud 500 Hz mode and eight quiet neighbours it masks.
+fn masked_cluster(loud_decay_per_s: f64) -> Bank {
+    let mut modes = vec![(500.0, loud_decay_per_s, 1.0)];
+    modes.extend((0..8).map(|k| (520.0 + 25.0 * k as f64, 0.5, 0.05)));
+    simple_bank(&modes)
+}
+
+/// Largest second difference of `x`: a step shows as a spike, a sine of amplitude `a` at
+/// `theta` radians per sample keeps it under `a theta^2`.
+fn max_second_difference(x: &[f32]) -> f32 {
+    x.windows(3)
+        .fold(0.0, |m, w| m.max((w[2] - 2.0 * w[1] + w[0]).abs()))
+}
+
+#[test]
+fn switching_modes_off_and_back_on_does_not_click() {
+    let bank = masked_cluster(1.0);
+    let mut pruned = pruned_engine(&bank);
+    let mut full = pruned_engine(&bank);
+    let mut c = full.controls().clone();
+    c.pruning = false;
+    full.set_controls(&c);
+    // Pruning switches the neighbours off within the first analysis frames...
+    let mut p = strike(&mut pruned, 0.3);
+    let mut u = strike(&mut full, 0.3);
+    assert_eq!(switched_off(&pruned).len(), 8, "the neighbours were not pruned");
+    // ... and turning pruning off brings them back.
+    let mut c = pruned.controls().clone();
+    c.pruning = false;
+    pruned.set_controls(&c);
+    p.extend(run(&mut pruned, 0.3));
+    u.extend(run(&mut full, 0.3));
+    assert!(switched_off(&pruned).is_empty());
+    // The difference is the neighbours' sum under a fade: smooth, with no step.
+    let diff: Vec<f32> = u.iter().zip(&p).map(|(a, b)| a - b).collect();
+    let q = peak(&diff);
+    assert!(q > 1e-3, "pruning changed nothing ({q})");
+    let theta = std::f32::consts::TAU * 700.0 / RATE;
+    let bound = 2.0 * q * theta * theta;
+    let spike = max_second_difference(&diff);
+    assert!(
+        spike < bound,
+        "second difference {spike} of the difference signal exceeds {bound} (peak {q}): a click"
+    );
+    assert!(
+        max_second_difference(&p) < max_second_difference(&u) * 1.05 + bound,
+        "the pruned output is rougher than the full one"
+    );
+}
+
+#[test]
+fn modes_brought_back_sound_in_phase_with_the_full_render() {
+    // The neighbours outlast their masker, so pruning wakes them once it has faded; and a
+    // settings change wakes the rest. Afterwards the pruned render is the full one.
+    let bank = masked_cluster(1.0);
+    let mut pruned = pruned_engine(&bank);
+    let mut full = pruned_engine(&bank);
+    let mut c = full.controls().clone();
+    c.pruning = false;
+    full.set_controls(&c);
+    strike(&mut pruned, 0.3);
+    strike(&mut full, 0.3);
+    assert_eq!(switched_off(&pruned).len(), 8);
+    let mut c = pruned.controls().clone();
+    c.pruning = false;
+    pruned.set_controls(&c);
+    // Fades last at most a quarter of a second.
+    run(&mut pruned, 0.3);
+    run(&mut full, 0.3);
+    let p = run(&mut pruned, 0.1);
+    let u = run(&mut full, 0.1);
+    let scale = peak(&u);
+    for (n, (a, b)) in p.iter().zip(&u).enumerate() {
+        assert!(
+            (a - b).abs() < 1e-4 * scale,
+            "sample {n}: pruned {a}, full {b} (peak {scale})"
+        );
+    }
+}
+
+#[test]
+fn a_masked_mode_returns_in_phase_when_its_masker_fades() {
+    // The masker falls by 87 dB a second (decay 10/s) and stops masking within a few tenths
+    // of a second; the neighbours ring for seconds.
+    let bank = masked_cluster(10.0);
+    let mut pruned = pruned_engine(&bank);
+    let mut full = pruned_engine(&bank);
+    let mut c = full.controls().clone();
+    c.pruning = false;
+    full.set_controls(&c);
+    strike(&mut pruned, 0.1);
+    strike(&mut full, 0.1);
+    let masked = switched_off(&pruned).len();
+    assert!(masked >= 4, "only {masked} neighbours pruned");
+    run(&mut pruned, 1.0);
+    run(&mut full, 1.0);
+    // (The masker itself has fallen under the threshold of hearing by now.)
+    let masker = mode_at(&pruned, 500.0);
+    let off = switched_off(&pruned);
+    assert!(
+        off.iter().all(|&m| m == masker),
+        "neighbours still off after the masker faded: {off:?}"
+    );
+    let p = run(&mut pruned, 0.1);
+    let u = run(&mut full, 0.1);
+    let scale = peak(&u);
+    assert!(scale > 1e-4);
+    for (n, (a, b)) in p.iter().zip(&u).enumerate() {
+        assert!(
+            (a - b).abs() < 1e-3 * scale,
+            "sample {n}: pruned {a}, full {b} (peak {scale})"
+        );
+    }
+}
+
+/// Seed 000 eq. 5.15 for a mode of the engine's bank struck with its gain as amplitude.
+fn remaining_energy(e: &Engine, m: usize) -> f64 {
+    let w = std::f64::consts::TAU * e.bank().freq_hz[m];
+    let alpha = e.bank().decay_per_s[m];
+    let a = e.bank().gains[m] as f64;
+    0.25 * w * w * a * a / (alpha * (alpha * alpha + w * w))
+}
+
+#[test]
+fn the_budget_keeps_the_modes_with_the_most_energy() {
+    // Gains and decays chosen so that energy (gain^2 / decay, roughly) ranks the modes
+    // differently from their amplitude: loud short-lived modes lose to quieter long ones.
+    let modes: Vec<(f64, f64, f64)> = (0..12)
+        .map(|k| {
+            let gain = 1.0 / (1.0 + k as f64);
+            let decay = if k % 2 == 0 { 40.0 } else { 0.5 };
+            (300.0 * (1.0 + k as f64 * 0.37), decay, gain)
+        })
+        .collect();
+    let bank = simple_bank(&modes);
+    let mut e = pruned_engine(&bank);
+    let mut c = e.controls().clone();
+    c.pruning = false;
+    c.mode_budget = 4;
+    e.set_controls(&c);
+    assert_eq!(e.mode_cap(), Some(4));
+    strike(&mut e, 0.1);
+    let n = e.bank().freq_hz.len();
+    let off = switched_off(&e);
+    let kept: Vec<usize> = (0..n).filter(|m| !off.contains(m)).collect();
+    let mut by_energy: Vec<usize> = (0..n).collect();
+    by_energy.sort_by(|&a, &b| remaining_energy(&e, b).total_cmp(&remaining_energy(&e, a)));
+    let mut want = by_energy[..4].to_vec();
+    want.sort();
+    assert_eq!(kept, want, "kept {kept:?}, the most energetic are {want:?}");
+    // The loudest mode is short-lived: not among them.
+    let loudest = (0..n)
+        .max_by(|&a, &b| e.bank().gains[a].total_cmp(&e.bank().gains[b]))
+        .unwrap();
+    assert!(!kept.contains(&loudest));
+    assert!(e.stats().live_modes - e.stats().dormant_modes <= 4);
+}
+
+#[test]
+fn the_automatic_budget_follows_the_measured_cost() {
+    let bank = dense_bank(300, 60.0);
+    let mut e = pruned_engine(&bank);
+    assert!(
+        e.ns_per_mode_sample() > 0.0,
+        "the engine measured no cost when prepared"
+    );
+    // With 1 ns per mode-sample at 48 kHz, 10% of real time is 100 ms / 48 us = 2083 modes,
+    // 1875 with the safety factor of seed 000 eq. 6.6.
+    e.set_ns_per_mode_sample(1.0);
+    let mut c = e.controls().clone();
+    c.pruning = false;
+    c.target_load_pct = 10.0;
+    e.set_controls(&c);
+    assert_eq!(e.mode_cap(), Some(1875));
+    // The smaller of a fixed and an automatic cap holds, and the engine keeps to it.
+    c.mode_budget = 5000;
+    e.set_controls(&c);
+    assert_eq!(e.mode_cap(), Some(1875));
+    e.set_ns_per_mode_sample(1000.0);
+    assert_eq!(e.mode_cap(), Some(1));
+    e.set_ns_per_mode_sample(50.0);
+    let cap = e.mode_cap().unwrap();
+    assert_eq!(cap, 37);
+    let events: Vec<NoteEvent> = (0..4).map(|k| on(0, 40 + 7 * k, 1.0)).collect();
+    render(&mut e, &events, 0.2, 256);
+    let s = e.stats();
+    assert!(s.live_modes > 4 * cap, "too few modes sounding to test the cap");
+    assert!(
+        s.live_modes - s.dormant_modes <= cap,
+        "{} modes computed, cap {cap}",
+        s.live_modes - s.dormant_modes
+    );
+}
