@@ -11,234 +11,71 @@
 //! against the rest of the synthesis; and the level of the difference between each pruned render
 //! and the unpruned one relative to the unpruned signal, per critical band.
 //!
-//! Run with `cargo bench --bench pruning`.
+//! Run with `cargo bench --bench pruning`. Settings for experiments, from the environment:
+//! `PRUNING_REPEATS` (timed renders per case, default 3, the fastest counts),
+//! `PRUNING_OFFSETS=2.5,5,20` (other masking offsets; the targets are read at 5 dB),
+//! `PRUNING_FRAME_MS` (another analysis frame) and `PRUNING_ONLY=5` (one pruned render with
+//! every counter, for profilers).
 
 use std::hint::black_box;
 use std::sync::Arc;
 use std::time::Instant;
 
-use modal_resonator::dsp::masking::hz_to_bark;
 use modal_resonator::dsp::ExciterKind;
 use modal_resonator::engine::{Controls, Engine, NoteEvent, PreparedBank};
-use modal_resonator::model::materials::{self, Material};
-use modal_resonator::model::shapes::{ModeLimits, RectangularPlate, Shape, MAX_AUDIBLE_HZ};
-use modal_resonator::model::{Bank, Mode, Position};
+use modal_resonator::model::{Bank, Position};
 
-const RATE_HZ: f64 = 48_000.0;
+#[path = "pruning/bands.rs"]
+mod bands;
+#[path = "pruning/scene.rs"]
+mod scene;
+
+use bands::{band_power, bark_to_hz, db};
+use scene::{hail, object_modes, objects, scene_bank, Impact, ENERGY_RANGE, FIRST_KEY};
+
+/// Sample rate of the renders.
+pub const RATE_HZ: f64 = 48_000.0;
 /// Longest block handed to the engine (blocks are also cut at every impact).
 const BLOCK: usize = 256;
 /// Timed renders per case; the fastest counts (the machine is shared).
 const REPEATS: usize = 3;
 
+/// Timed renders per case: `PRUNING_REPEATS`, else [`REPEATS`].
 fn repeats() -> usize {
     std::env::var("PRUNING_REPEATS")
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(REPEATS)
 }
-/// Mean impacts per second over the whole scene.
-const IMPACTS_PER_S: f64 = 30.0;
-
-fn impacts_per_s() -> f64 {
-    std::env::var("PRUNING_RATE")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(IMPACTS_PER_S)
-}
-/// Span of impact energies: the 1/E law runs over this ratio (40 dB).
-const ENERGY_RANGE: f64 = 1e4;
-/// MIDI key of the first object; object `k` plays on `FIRST_KEY + k`.
-const FIRST_KEY: u8 = 48;
-
-/// One object of the scene.
-struct Object {
-    name: &'static str,
-    plate: RectangularPlate,
-    material: &'static Material,
-    modes: usize,
-    /// Level of the object's loudest mode relative to the others', in dB.
-    level_db: f64,
-    /// Relative chance of being hit.
-    exposure: f64,
-}
-
-fn objects() -> Vec<Object> {
-    let plate = |x: f64, y: f64, h: f64| RectangularPlate {
-        length_x_m: x,
-        length_y_m: y,
-        thickness_m: h,
-    };
-    vec![
-        Object {
-            name: "roof pane 1",
-            plate: plate(0.9, 0.6, 2.0e-3),
-            material: &materials::ALUMINIUM,
-            modes: 100,
-            level_db: -6.0,
-            exposure: 3.0,
-        },
-        Object {
-            name: "roof pane 2",
-            plate: plate(1.1, 0.7, 2.5e-3),
-            material: &materials::ALUMINIUM,
-            modes: 150,
-            level_db: -6.0,
-            exposure: 3.0,
-        },
-        Object {
-            name: "roof pane 3",
-            plate: plate(1.2, 0.8, 3.0e-3),
-            material: &materials::STEEL,
-            modes: 200,
-            level_db: -4.0,
-            exposure: 3.0,
-        },
-        Object {
-            name: "roof pane 4",
-            plate: plate(1.5, 1.0, 1.5e-3),
-            material: &materials::STEEL,
-            modes: 1050,
-            level_db: -3.0,
-            exposure: 3.0,
-        },
-        Object {
-            name: "plate 1",
-            plate: plate(0.25, 0.25, 1.2e-3),
-            material: &materials::STEEL,
-            modes: 200,
-            level_db: -10.0,
-            exposure: 1.0,
-        },
-        Object {
-            name: "plate 2",
-            plate: plate(0.3, 0.3, 1.5e-3),
-            material: &materials::STEEL,
-            modes: 200,
-            level_db: -10.0,
-            exposure: 1.0,
-        },
-        Object {
-            name: "plate 3",
-            plate: plate(0.35, 0.35, 1.8e-3),
-            material: &materials::BRASS,
-            modes: 200,
-            level_db: -10.0,
-            exposure: 1.0,
-        },
-        Object {
-            name: "table",
-            plate: plate(1.6, 0.8, 30e-3),
-            material: &materials::SPRUCE,
-            modes: 100,
-            level_db: -2.0,
-            exposure: 2.0,
-        },
-        Object {
-            name: "can",
-            plate: plate(1.2, 0.5, 0.8e-3),
-            material: &materials::STEEL,
-            modes: 1100,
-            level_db: 0.0,
-            exposure: 1.5,
-        },
-    ]
-}
-
-/// Modes of the scene's objects start here: what lies below hearing is left out of a model.
-const LOWEST_HZ: f64 = 20.0;
-
-/// The lowest `o.modes` audible modes of object `o` struck at `strike`.
-fn object_modes(o: &Object, strike: &[Position]) -> Vec<Mode> {
-    let limits = ModeLimits {
-        max_freq_hz: MAX_AUDIBLE_HZ,
-        max_modes: o.modes + 32,
-    };
-    let mut modes = Shape::RectangularPlate(o.plate.clone())
-        .modes(o.material, strike, &limits)
-        .unwrap_or_else(|e| panic!("{}: {e}", o.name));
-    modes.retain(|m| m.freq_hz >= LOWEST_HZ);
-    assert!(modes.len() >= o.modes, "{} has too few modes", o.name);
-    modes.truncate(o.modes);
-    modes
-}
-
-/// The scene as one bank: position `k` is object `k`, struck off-centre.
-fn scene_bank(objects: &[Object]) -> Bank {
-    let positions: Vec<Position> = (0..objects.len())
-        .map(|k| Position {
-            name: objects[k].name.into(),
-            coords: vec![k as f64],
-        })
-        .collect();
-    let mut bank = Bank::new("hail on a picnic", positions);
-    let strike = [Position {
-        name: "off-centre".into(),
-        coords: vec![0.38, 0.42],
-    }];
-    for (k, o) in objects.iter().enumerate() {
-        let modes = object_modes(o, &strike);
-        let scale = 10f64.powf(o.level_db / 20.0);
-        for m in modes {
-            let mut gains = vec![0.0; objects.len()];
-            gains[k] = m.gains[0] * scale;
-            bank.modes.push(Mode { gains, ..m });
-        }
-    }
-    bank
-}
-
-/// One impact: sample, object, velocity.
-type Impact = (usize, usize, f32);
-
-/// A Poisson rain of impacts on objects chosen by exposure, energies drawn from a 1/E law
-/// (log-uniform over `ENERGY_RANGE`), seeded.
-fn hail(objects: &[Object], seconds: f64, seed: u64) -> Vec<Impact> {
-    let mut s = seed;
-    let mut uniform = move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
-    let total: f64 = objects.iter().map(|o| o.exposure).sum();
-    let mut t = 0.0;
-    let mut out = Vec::new();
-    loop {
-        t += -(1.0 - uniform()).ln() / impacts_per_s();
-        if t >= seconds {
-            break;
-        }
-        let mut pick = uniform() * total;
-        let object = objects
-            .iter()
-            .position(|o| {
-                pick -= o.exposure;
-                pick < 0.0
-            })
-            .unwrap_or(objects.len() - 1);
-        // Energy E / E_max = range^-u: density proportional to 1/E. Velocity is the amplitude.
-        let energy = ENERGY_RANGE.powf(-uniform());
-        out.push(((t * RATE_HZ) as usize, object, energy.sqrt() as f32));
-    }
-    out
-}
 
 /// What one render measured.
 struct Run {
+    /// Left output.
     left: Vec<f32>,
+    /// Right output.
     right: Vec<f32>,
+    /// Wall time of the render, seconds.
     wall_s: f64,
+    /// Mode-samples the kernels computed (row padding included).
     mode_samples: u64,
     /// Time-average of dormant over live modes.
     pruned_share: f64,
+    /// Pruning analyses run.
     analyses: u64,
+    /// Modes those analyses and the strikes' decisions looked at.
     candidates: u64,
+    /// Time in the analyses, seconds.
     analysis_s: f64,
+    /// Time deciding strikes on dormant modes, seconds.
     wake_s: f64,
+    /// Modes woken by strikes and input.
     woken: u64,
+    /// Every pruning counter.
     stats: modal_resonator::engine::PruningStats,
 }
 
+/// The scene's controls: mallet strikes, no key tracking, a voice per object; pruning at
+/// `masking_offset_db` when given.
 fn controls(bank: &Bank, objects: usize, masking_offset_db: Option<f32>) -> Controls {
     let mut c = Controls::for_bank(bank);
     c.key_tracking = 0.0;
@@ -345,73 +182,6 @@ fn measure(prepared: &Arc<PreparedBank>, impacts: &[Impact], seconds: f64, c: &C
     run.analysis_s = best.analysis_s;
     run.wake_s = best.wake_s;
     run
-}
-
-/// In-place iterative radix-2 FFT of `re`, `im` (length a power of two).
-fn fft(re: &mut [f64], im: &mut [f64]) {
-    let n = re.len();
-    let mut j = 0;
-    for i in 1..n {
-        let mut bit = n >> 1;
-        while j & bit != 0 {
-            j ^= bit;
-            bit >>= 1;
-        }
-        j |= bit;
-        if i < j {
-            re.swap(i, j);
-            im.swap(i, j);
-        }
-    }
-    let twiddles: Vec<(f64, f64)> = (0..n / 2)
-        .map(|k| (-std::f64::consts::TAU * k as f64 / n as f64).sin_cos())
-        .collect();
-    let mut len = 2;
-    while len <= n {
-        let stride = n / len;
-        for start in (0..n).step_by(len) {
-            for k in 0..len / 2 {
-                let (s, c) = twiddles[k * stride];
-                let (a, b) = (start + k, start + k + len / 2);
-                let (tr, ti) = (re[b] * c - im[b] * s, re[b] * s + im[b] * c);
-                re[b] = re[a] - tr;
-                im[b] = im[a] - ti;
-                re[a] += tr;
-                im[a] += ti;
-            }
-        }
-        len <<= 1;
-    }
-}
-
-/// Power of `x` in each critical band (Bark 0-1, 1-2, ... 24-25), averaged over Hann-windowed
-/// frames (Welch).
-fn band_power(x: &[f32]) -> [f64; 25] {
-    const N: usize = 4096;
-    let window: Vec<f64> = (0..N)
-        .map(|i| 0.5 - 0.5 * (std::f64::consts::TAU * i as f64 / N as f64).cos())
-        .collect();
-    let band_of: Vec<usize> = (0..N / 2)
-        .map(|k| (hz_to_bark(k as f64 * RATE_HZ / N as f64) as usize).min(24))
-        .collect();
-    let mut bands = [0.0; 25];
-    let (mut re, mut im) = (vec![0.0; N], vec![0.0; N]);
-    for frame in x.chunks_exact(N / 2).collect::<Vec<_>>().windows(2) {
-        for i in 0..N / 2 {
-            re[i] = frame[0][i] as f64 * window[i];
-            re[i + N / 2] = frame[1][i] as f64 * window[i + N / 2];
-        }
-        im.fill(0.0);
-        fft(&mut re, &mut im);
-        for k in 1..N / 2 {
-            bands[band_of[k]] += re[k] * re[k] + im[k] * im[k];
-        }
-    }
-    bands
-}
-
-fn db(x: f64) -> f64 {
-    10.0 * x.max(1e-300).log10()
 }
 
 fn main() {
@@ -557,19 +327,6 @@ fn main() {
         print!(" {:>11}", name);
     }
     println!();
-    let edge_hz = |bark: f64| {
-        // Invert the Bark scale by bisection.
-        let (mut lo, mut hi) = (0.0, 30_000.0);
-        for _ in 0..60 {
-            let mid = 0.5 * (lo + hi);
-            if hz_to_bark(mid) < bark {
-                lo = mid
-            } else {
-                hi = mid
-            }
-        }
-        lo
-    };
     for b in 0..25 {
         if reference[b] <= 0.0 {
             continue;
@@ -578,8 +335,8 @@ fn main() {
             "{:>2}-{:<2} {:>6.0}-{:<6.0} {:>12.1}",
             b,
             b + 1,
-            edge_hz(b as f64),
-            edge_hz(b as f64 + 1.0),
+            bark_to_hz(b as f64),
+            bark_to_hz(b as f64 + 1.0),
             db(reference[b] / top)
         );
         for d in &diffs {

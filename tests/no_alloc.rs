@@ -177,7 +177,13 @@ fn pruning_and_the_budget_never_allocate() {
     let storms: Vec<Vec<NoteEvent>> = (0..300)
         .map(|b| {
             (0..6)
-                .map(|i| NoteEvent::on(((i * 41 + b * 13) % block) as u32, (30 + (b * 7 + i * 11) % 60) as u8, ((b + i) % 10) as f32 / 9.0 + 0.05))
+                .map(|i| {
+                    NoteEvent::on(
+                        ((i * 41 + b * 13) % block) as u32,
+                        (30 + (b * 7 + i * 11) % 60) as u8,
+                        ((b + i) % 10) as f32 / 9.0 + 0.05,
+                    )
+                })
                 .collect::<Vec<_>>()
         })
         .map(|mut v| {
@@ -202,5 +208,8 @@ fn pruning_and_the_budget_never_allocate() {
     });
     assert_eq!(count, 0, "process allocated or freed {count} times");
     assert!(dormant > 0, "pruning never switched a mode off");
-    assert!(e.pruning_stats().absorbed > 0, "no strike met a dormant mode");
+    assert!(
+        e.pruning_stats().absorbed > 0,
+        "no strike met a dormant mode"
+    );
 }

@@ -119,7 +119,10 @@ fn pruning_never_removes_the_loudest_mode() {
     let off = switched_off(&e);
     assert_eq!(off.len(), 2, "switched off: {off:?}");
     assert!(!off.contains(&loudest), "the loudest mode was pruned");
-    assert!(peak(&out[out.len() - 480..]) > 0.0, "the object fell silent");
+    assert!(
+        peak(&out[out.len() - 480..]) > 0.0,
+        "the object fell silent"
+    );
 }
 
 /// A loud 500 Hz mode and eight quiet neighbours it masks.
@@ -147,7 +150,11 @@ fn switching_modes_off_and_back_on_does_not_click() {
     // Pruning switches the neighbours off within the first analysis frames...
     let mut p = strike(&mut pruned, 0.3);
     let mut u = strike(&mut full, 0.3);
-    assert_eq!(switched_off(&pruned).len(), 8, "the neighbours were not pruned");
+    assert_eq!(
+        switched_off(&pruned).len(),
+        8,
+        "the neighbours were not pruned"
+    );
     // ... and turning pruning off brings them back.
     let mut c = pruned.controls().clone();
     c.pruning = false;
@@ -308,7 +315,10 @@ fn the_automatic_budget_follows_the_measured_cost() {
     let events: Vec<NoteEvent> = (0..4).map(|k| on(0, 40 + 7 * k, 1.0)).collect();
     render(&mut e, &events, 0.2, 256);
     let s = e.stats();
-    assert!(s.live_modes > 4 * cap, "too few modes sounding to test the cap");
+    assert!(
+        s.live_modes > 4 * cap,
+        "too few modes sounding to test the cap"
+    );
     assert!(
         s.live_modes - s.dormant_modes <= cap,
         "{} modes computed, cap {cap}",

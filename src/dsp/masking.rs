@@ -138,7 +138,7 @@ pub fn remaining_energy(amplitude: f32, omega: f32, alpha: f32) -> f32 {
 #[inline]
 pub fn power_to_db(power: f32) -> f32 {
     // 10 log10(x) = 10 log10(2) log2(x)
-    3.010_299_9 * fast_log2(power.max(1e-30))
+    3.010_3 * fast_log2(power.max(1e-30))
 }
 
 /// `log2(x)` for positive normal `x` to within 3e-4: the float's exponent plus a quartic in its

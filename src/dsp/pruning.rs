@@ -13,7 +13,7 @@
 //!
 //! Storage is sized by [`MaskingPass::with_capacity`]; [`MaskingPass::run`] never allocates.
 
-use std::cmp::Reverse;
+use std::cmp::{Ordering, Reverse};
 
 use super::masking::{upper_slope_db_per_bark, LOWER_SLOPE_DB_PER_BARK};
 
@@ -194,7 +194,7 @@ impl MaskingPass {
             let loudest = rank == 0 && l >= loudest_prior;
             // Step 6: below the threshold of hearing (the loudest mode is always kept, so
             // pruning never silences a sounding object).
-            if !loudest && !(l > threshold_db[i]) {
+            if !loudest && l.partial_cmp(&threshold_db[i]) != Some(Ordering::Greater) {
                 verdicts[i] = Verdict::Inaudible;
                 continue;
             }
@@ -352,155 +352,4 @@ impl Ord for OrderedEnergy {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::super::masking::{masking_curve_db, masking_threshold_db};
-    use super::*;
-
-    /// The seed's pseudo-code, literally: every pair, `O(N^2)`.
-    fn reference(level: &[f32], bark: &[f32], threshold: &[f32], av: f32) -> Vec<bool> {
-        let n = level.len();
-        let mut order: Vec<usize> = (0..n).collect();
-        order.sort_by(|&a, &b| level[b].total_cmp(&level[a]));
-        let mut on = vec![false; n];
-        let mut masker = vec![false; n];
-        for (rank, &i) in order.iter().enumerate() {
-            on[i] = rank == 0 || level[i] > threshold[i];
-            masker[i] = on[i];
-        }
-        for a in 0..n {
-            let i = order[a];
-            if !masker[i] {
-                continue;
-            }
-            for &k in &order[a + 1..] {
-                if !on[k] {
-                    continue;
-                }
-                let th = masking_threshold_db(bark[i], level[i], av, bark[k], threshold[k]);
-                if level[k] < th {
-                    on[k] = false;
-                    masker[k] = false;
-                } else if level[k] < th + av {
-                    masker[k] = false;
-                }
-            }
-        }
-        on
-    }
-
-    fn random_scene(n: usize, seed: u32) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
-        let mut s = seed;
-        let mut rnd = move || {
-            s ^= s << 13;
-            s ^= s >> 17;
-            s ^= s << 5;
-            s as f32 / u32::MAX as f32
-        };
-        let level: Vec<f32> = (0..n).map(|_| 90.0 * rnd()).collect();
-        let bark: Vec<f32> = (0..n).map(|_| 24.0 * rnd()).collect();
-        let threshold: Vec<f32> = (0..n).map(|_| 10.0 * rnd()).collect();
-        (level, bark, threshold)
-    }
-
-    #[test]
-    fn the_pass_agrees_with_the_seeds_pairwise_algorithm() {
-        for (n, seed, av) in [(50, 1, 5.0), (700, 2, 2.5), (2000, 3, 10.0), (300, 4, 0.0)] {
-            let (level, bark, threshold) = random_scene(n, seed);
-            let mut pass = MaskingPass::with_capacity(n);
-            let mut verdicts = vec![Verdict::Inaudible; n];
-            pass.run(&level, &bark, &threshold, av, &mut verdicts);
-            let want = reference(&level, &bark, &threshold, av);
-            for i in 0..n {
-                assert_eq!(
-                    verdicts[i].is_audible(),
-                    want[i],
-                    "n {n}, a_v {av}: candidate {i} ({} dB at {} Bark): {:?}",
-                    level[i],
-                    bark[i],
-                    verdicts[i]
-                );
-            }
-            // Roughly 2 sqrt(N) maskers (seed 001, footnote 1): far fewer than N.
-            assert!(pass.num_maskers() < n / 2, "{} maskers", pass.num_maskers());
-        }
-    }
-
-    #[test]
-    fn a_loud_mode_masks_a_quiet_neighbour_and_not_a_distant_one() {
-        // 70 dB at 10 Bark; 40 dB at 10.5 Bark (curve 65 - 22 * 0.5 = 54 dB there: masked);
-        // 40 dB at 16 Bark (curve 65 - 8 * 6 = 17 dB: heard).
-        let level = [70.0, 40.0, 40.0];
-        let bark = [10.0, 10.5, 16.0];
-        let threshold = [3.0; 3];
-        let mut pass = MaskingPass::with_capacity(3);
-        let mut v = [Verdict::Inaudible; 3];
-        pass.run(&level, &bark, &threshold, 5.0, &mut v);
-        assert_eq!(v[0], Verdict::Audible { masker: true });
-        assert_eq!(v[1], Verdict::Masked { by: 0 });
-        assert!(v[2].is_audible(), "{:?}", v[2]);
-        assert!(masking_curve_db(10.0, 70.0, 5.0, 10.5) > 40.0);
-    }
-
-    #[test]
-    fn a_quiet_isolated_mode_above_the_threshold_is_kept_and_one_below_is_not() {
-        let level = [20.0, 8.0, 2.0];
-        let bark = [5.0, 20.0, 22.0];
-        let threshold = [5.0, 6.0, 9.0];
-        let mut pass = MaskingPass::with_capacity(3);
-        let mut v = [Verdict::Inaudible; 3];
-        pass.run(&level, &bark, &threshold, 5.0, &mut v);
-        assert!(v[0].is_audible() && v[1].is_audible());
-        assert_eq!(v[2], Verdict::Inaudible);
-    }
-
-    #[test]
-    fn the_loudest_mode_is_never_removed() {
-        // Even below the threshold of hearing.
-        let mut pass = MaskingPass::with_capacity(4);
-        let mut v = [Verdict::Inaudible; 3];
-        pass.run(
-            &[-10.0, -20.0, -30.0],
-            &[1.0, 2.0, 3.0],
-            &[20.0; 3],
-            5.0,
-            &mut v,
-        );
-        assert_eq!(v[0], Verdict::Audible { masker: true });
-        assert_eq!(&v[1..], &[Verdict::Inaudible; 2]);
-        // And among random scenes at every offset.
-        for seed in 1..20 {
-            let (level, bark, threshold) = random_scene(200, seed);
-            let loudest = (0..200)
-                .max_by(|&a, &b| level[a].total_cmp(&level[b]))
-                .unwrap();
-            let mut verdicts = vec![Verdict::Inaudible; 200];
-            let mut pass = MaskingPass::with_capacity(200);
-            pass.run(&level, &bark, &threshold, 0.0, &mut verdicts);
-            assert!(verdicts[loudest].is_audible(), "seed {seed}");
-        }
-    }
-
-    #[test]
-    fn a_larger_offset_prunes_less() {
-        let (level, bark, threshold) = random_scene(1000, 9);
-        let mut pass = MaskingPass::with_capacity(1000);
-        let mut verdicts = vec![Verdict::Inaudible; 1000];
-        let mut kept = Vec::new();
-        for av in [0.0, 2.5, 5.0, 10.0, 20.0] {
-            pass.run(&level, &bark, &threshold, av, &mut verdicts);
-            kept.push(verdicts.iter().filter(|v| v.is_audible()).count());
-        }
-        assert!(kept.windows(2).all(|w| w[0] <= w[1]), "{kept:?}");
-    }
-
-    #[test]
-    fn the_budget_keeps_the_most_energetic() {
-        let mut ranked: Vec<(f32, u32)> = (0..100)
-            .map(|i| (((i * 37) % 100) as f32, i as u32))
-            .collect();
-        keep_most_energetic(&mut ranked, 10);
-        let mut top: Vec<f32> = ranked[..10].iter().map(|r| r.0).collect();
-        top.sort_by(f32::total_cmp);
-        assert_eq!(top, (90..100).map(|e| e as f32).collect::<Vec<_>>());
-    }
-}
+mod tests;

@@ -16,12 +16,17 @@
 //! fades back in beside it in a *ghost* slot that ignores input, and joins it when the fade ends.
 
 mod dormant;
+mod fades;
+mod meters;
+mod poles;
 mod strike;
 #[cfg(test)]
 mod tests;
+mod views;
 
-pub use dormant::{ActiveMode, DormantMode, FADE_DEPTH_NEPERS};
+pub use dormant::FADE_DEPTH_NEPERS;
 pub use strike::{Pulse, PulseShape};
+pub use views::{ActiveMode, DormantMode};
 
 use super::coeffs::ModeCoeffs;
 use super::coeffs_batch::coeffs_batch;
@@ -238,76 +243,6 @@ impl ResonatorBank {
         slot
     }
 
-    /// Sets the coefficients of every live mode to those of the pole `pole_of(mode) = (theta,
-    /// delta)` (angle in radians per sample, radius `exp(-delta)`; see
-    /// [`ModeCoeffs::from_angle_radius`]), computed for all modes at once.
-    ///
-    /// Dormant modes take their new poles from now on, their state carried with the old ones up
-    /// to now.
-    pub fn set_poles_with(&mut self, mut pole_of: impl FnMut(usize) -> (f64, f64)) {
-        let n = self.rows_active * COLUMNS;
-        for slot in 0..n {
-            let entry = self.mode_of_slot[slot];
-            // A pole at (0, 0) gives coefficients (0, 0): empty slots stay silent.
-            (self.theta[slot], self.delta[slot]) = if entry == NONE {
-                (0.0, 0.0)
-            } else {
-                pole_of((entry & !GHOST) as usize)
-            };
-        }
-        let now = self.clock;
-        for d in &mut self.dormant[..self.num_dormant] {
-            d.advance_to(now);
-            let (theta, delta) = pole_of(d.mode as usize);
-            d.set_pole(theta, delta);
-        }
-        self.refresh_coeffs();
-    }
-
-    /// Recomputes every slot's coefficients from its pole and fade, all at once.
-    fn refresh_coeffs(&mut self) {
-        let n = self.rows_active * COLUMNS;
-        for slot in 0..n {
-            if self.theta[slot].is_nan() {
-                (self.theta[slot], self.delta[slot]) = self.pole_of_slot(slot);
-            }
-            self.pole_delta[slot] = self.delta[slot] + self.fade_delta[slot];
-        }
-        coeffs_batch(
-            &self.theta[..n],
-            &self.pole_delta[..n],
-            &mut self.q_re[..n],
-            &mut self.q_im[..n],
-        );
-        self.coeffs_stale = false;
-    }
-
-    /// Recomputes one slot's coefficients from its pole and fade.
-    fn set_slot_coeffs(&mut self, slot: usize) {
-        let (theta, delta) = self.pole_of_slot(slot);
-        (self.theta[slot], self.delta[slot]) = (theta, delta);
-        let (mut q_re, mut q_im) = ([0.0], [0.0]);
-        coeffs_batch(
-            &[theta],
-            &[delta + self.fade_delta[slot]],
-            &mut q_re,
-            &mut q_im,
-        );
-        (self.q_re[slot], self.q_im[slot]) = (q_re[0], q_im[0]);
-    }
-
-    /// The pole `(theta, delta)` of a slot without its fade: as set, or read back from the
-    /// coefficients the kernel runs (`p = 1 + q`).
-    fn pole_of_slot(&self, slot: usize) -> (f64, f64) {
-        if !self.theta[slot].is_nan() {
-            return (self.theta[slot], self.delta[slot]);
-        }
-        let (q_re, q_im) = (self.q_re[slot] as f64, self.q_im[slot] as f64);
-        // |p|^2 = 1 + 2 q_re + q_re^2 + q_im^2, kept exact near 1.
-        let delta = -0.5 * (2.0 * q_re + q_re * q_re + q_im * q_im).ln_1p();
-        (q_im.atan2(1.0 + q_re), delta - self.fade_delta[slot])
-    }
-
     /// Sets the input gain of every live mode to `gain_of(mode)`.
     pub fn set_gains_with(&mut self, mut gain_of: impl FnMut(usize) -> f32) {
         for slot in self.live_slots() {
@@ -372,7 +307,7 @@ impl ResonatorBank {
         {
             let e = re * re + im * im;
             // A state that is not a number is retired too.
-            suspects += (*entry != NONE && *fade == 0.0 && !(e >= threshold_sq)) as u32;
+            suspects += (*entry != NONE && *fade == 0.0 && below(e, threshold_sq)) as u32;
         }
         if suspects == 0 {
             return 0;
@@ -390,7 +325,7 @@ impl ResonatorBank {
                     continue;
                 }
                 let e = self.re[slot] * self.re[slot] + self.im[slot] * self.im[slot];
-                if !(e >= threshold_sq) {
+                if below(e, threshold_sq) {
                     self.remove_slot(slot);
                     self.claimed[column] -= 1;
                     retired += 1;
@@ -401,63 +336,6 @@ impl ResonatorBank {
             self.update_rows();
         }
         retired
-    }
-
-    /// Summed squared amplitude `|z|^2` of the live modes, computed or dormant (ghosts and fades
-    /// as they are now).
-    pub fn energy(&self) -> f32 {
-        let computed: f32 = self
-            .live_slots()
-            .filter(|&s| self.fade_delta[s] <= 0.0)
-            .map(|s| self.re[s] * self.re[s] + self.im[s] * self.im[s])
-            .sum();
-        let now = self.clock;
-        let dormant: f32 = self.dormant[..self.num_dormant]
-            .iter()
-            .map(|d| d.power_at(now))
-            .sum();
-        computed + dormant
-    }
-
-    /// Calls `visit(mode, |z|^2)` for every live mode, computed or dormant, with the power of its
-    /// true state: a mode fading out as its record carries it, a mode fading in as it will be
-    /// when the fade ends, a ghost's ringing added to its mode's. For meters: reads the state and
-    /// changes nothing.
-    pub fn visit_energies(&self, mut visit: impl FnMut(usize, f32)) {
-        for slot in self.live_slots() {
-            let entry = self.mode_of_slot[slot];
-            // Ghosts join their modes; a mode fading out is visited through its record.
-            if entry & GHOST != 0 || self.fade_delta[slot] > 0.0 {
-                continue;
-            }
-            let mode = entry as usize;
-            let (mut re, mut im) = self.true_state(slot);
-            let ghost = self.ghost_of_mode[mode];
-            if ghost != NONE {
-                // The phasor is linear: the old ringing adds to the new.
-                let (g_re, g_im) = self.true_state(ghost as usize);
-                re += g_re;
-                im += g_im;
-            }
-            visit(mode, re * re + im * im);
-        }
-        let now = self.clock;
-        for d in &self.dormant[..self.num_dormant] {
-            visit(d.mode as usize, d.power_at(now));
-        }
-    }
-
-    /// The state of a slot without what a fade in still holds back: a slot growing by
-    /// `-fade_delta` per sample meets its true state when the fade ends.
-    fn true_state(&self, slot: usize) -> (f32, f32) {
-        let fade = self.fade_delta[slot];
-        if fade < 0.0 {
-            let left = self.fade_end[slot].saturating_sub(self.clock) as f64;
-            let k = (-fade * left).exp() as f32;
-            (self.re[slot] * k, self.im[slot] * k)
-        } else {
-            (self.re[slot], self.im[slot])
-        }
     }
 
     /// Silences every mode.
@@ -542,4 +420,13 @@ impl ResonatorBank {
         let fullest = self.live.iter().copied().max().unwrap_or(0) as usize;
         self.rows_active = fullest.div_ceil(ROW_BLOCK) * ROW_BLOCK;
     }
+}
+
+/// Whether power `e` is under `threshold_sq`, or not a number (a state gone bad is retired too).
+#[inline]
+fn below(e: f32, threshold_sq: f32) -> bool {
+    !matches!(
+        e.partial_cmp(&threshold_sq),
+        Some(std::cmp::Ordering::Greater | std::cmp::Ordering::Equal)
+    )
 }

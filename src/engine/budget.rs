@@ -94,7 +94,12 @@ fn stress_test(kernel: Kernel, sample_rate_hz: f64) -> f64 {
         vec![0.0f32; CALIBRATION_SAMPLES],
         vec![0.0f32; CALIBRATION_SAMPLES],
     );
-    engine.process(&strikes, None, &mut l[..CONTROL_PERIOD], &mut r[..CONTROL_PERIOD]);
+    engine.process(
+        &strikes,
+        None,
+        &mut l[..CONTROL_PERIOD],
+        &mut r[..CONTROL_PERIOD],
+    );
     let mut best = f64::INFINITY;
     for _ in 0..CALIBRATION_REPEATS {
         let before = engine.stats().computed_mode_samples;

@@ -1,6 +1,8 @@
 //! The engine's controls: plain values in natural units, with their ranges, defaults and names in
 //! one table shared by the plugin's parameters, the command line and the tests.
 
+mod by_name;
+
 use super::position::PositionMap;
 use crate::dsp::ExciterKind;
 use crate::model::Bank;
@@ -362,137 +364,7 @@ impl Controls {
             .map(|q| q.clamp(MATERIAL_Q_RANGE.0, MATERIAL_Q_RANGE.1));
         c
     }
-
-    /// Sets a control from text, as in `--set name=value`: any numeric control,
-    /// `material_q` (a number or `authored`), `material` (plastic, wood, ceramic, glass, metal)
-    /// or `exciter` (impulse, mallet, noise). Values outside a range are errors, not clamped.
-    pub fn set_by_name(&mut self, name: &str, value: &str) -> Result<(), String> {
-        let value = value.trim();
-        match name {
-            "material" => {
-                let m = Material::from_name(value).ok_or_else(|| {
-                    let names: Vec<_> = Material::ALL.iter().map(|m| m.name()).collect();
-                    format!(
-                        "material: expected one of {}, found \"{value}\"",
-                        names.join(", ")
-                    )
-                })?;
-                self.set_material(m);
-                Ok(())
-            }
-            "exciter" => {
-                self.exciter = ExciterKind::from_name(value).ok_or_else(|| {
-                    let names: Vec<_> = ExciterKind::ALL.iter().map(|k| k.name()).collect();
-                    format!(
-                        "exciter: expected one of {}, found \"{value}\"",
-                        names.join(", ")
-                    )
-                })?;
-                Ok(())
-            }
-            "pruning" => {
-                self.pruning = match value.to_ascii_lowercase().as_str() {
-                    "on" | "true" | "1" => true,
-                    "off" | "false" | "0" => false,
-                    _ => {
-                        return Err(format!(
-                            "pruning: expected on or off (true, false, 1, 0), found \"{value}\""
-                        ))
-                    }
-                };
-                Ok(())
-            }
-            "material_q" if value == "authored" => {
-                self.material_q = None;
-                Ok(())
-            }
-            "material_q" => {
-                let q = parse_in_range(name, value, MATERIAL_Q_RANGE.0, MATERIAL_Q_RANGE.1)?;
-                self.material_q = Some(q);
-                Ok(())
-            }
-            _ => {
-                let spec = NUMERIC_CONTROLS
-                    .iter()
-                    .find(|s| s.name == name)
-                    .ok_or_else(|| {
-                        let mut names: Vec<_> = NUMERIC_CONTROLS.iter().map(|s| s.name).collect();
-                        names.extend(["material_q", "material", "exciter"]);
-                        format!(
-                            "unknown control \"{name}\"; known controls: {}",
-                            names.join(", ")
-                        )
-                    })?;
-                let v = parse_in_range(name, value, spec.min, spec.max)?;
-                if spec.integer && v.fract() != 0.0 {
-                    return Err(format!(
-                        "{name}: expected a whole number from {} to {}, found {v}",
-                        spec.min, spec.max
-                    ));
-                }
-                (spec.set)(self, v);
-                Ok(())
-            }
-        }
-    }
-}
-
-fn parse_in_range(name: &str, value: &str, min: f32, max: f32) -> Result<f32, String> {
-    let v: f32 = value
-        .parse()
-        .map_err(|_| format!("{name}: expected a number from {min} to {max}, found \"{value}\""))?;
-    if !(min..=max).contains(&v) {
-        return Err(format!(
-            "{name}: expected a number from {min} to {max}, found {v}"
-        ));
-    }
-    Ok(v)
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn sanitizing_clamps_and_replaces_nan() {
-        let c = Controls {
-            size_ratio: f32::NAN,
-            width: 7.0,
-            truncation_db: -1e9,
-            material_q: Some(f32::INFINITY),
-            ..Controls::default()
-        }
-        .sanitized();
-        assert_eq!(c.size_ratio, 1.0);
-        assert_eq!(c.width, 1.0);
-        assert_eq!(c.truncation_db, -140.0);
-        assert_eq!(c.material_q, Some(MATERIAL_Q_RANGE.1));
-    }
-
-    #[test]
-    fn set_by_name_reports_range_and_names() {
-        let mut c = Controls::default();
-        c.set_by_name("material_q", "800").unwrap();
-        assert_eq!(c.material_q, Some(800.0));
-        c.set_by_name("material", "wood").unwrap();
-        assert_eq!(c.material_q, Some(Material::Wood.q()));
-        assert!(c
-            .set_by_name("size_ratio", "9")
-            .unwrap_err()
-            .contains("0.25 to 4"));
-        assert!(c
-            .set_by_name("sise_ratio", "1")
-            .unwrap_err()
-            .contains("unknown control"));
-        assert!(c
-            .set_by_name("exciter", "hammer")
-            .unwrap_err()
-            .contains("impulse, mallet, noise"));
-        assert!(c
-            .set_by_name("polyphony", "2.5")
-            .unwrap_err()
-            .contains("whole number"));
-        c.set_by_name("polyphony", "8").unwrap();
-        assert_eq!(c.polyphony, 8);
-    }
-}
+mod tests;

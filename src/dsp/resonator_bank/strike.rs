@@ -222,7 +222,9 @@ impl ResonatorBank {
 /// A complex number in `f64`, for the few operations above.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct C {
+    /// Real part.
     re: f64,
+    /// Imaginary part.
     im: f64,
 }
 

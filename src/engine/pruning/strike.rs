@@ -149,14 +149,7 @@ impl Engine {
                 continue;
             }
             p.cands.push(
-                i,
-                generation,
-                d.mode,
-                d.level_db,
-                d.theta,
-                d.delta,
-                DORMANT,
-                &reading,
+                i, generation, d.mode, d.level_db, d.theta, d.delta, DORMANT, &reading,
             );
         }
         for &(mode, recheck_at) in &p.rechecks[..p.num_rechecks] {

@@ -1,0 +1,280 @@
+//! One analysis over every voice: steps 1 to 8 of seed 001's pseudo-code, with the budget, on
+//! analysis frame boundaries.
+
+use std::time::Instant;
+
+use super::candidates::{Reading, DORMANT, DROP, LOCKED, OVER_BUDGET};
+use super::{fade_samples, frame_samples, samples_to_cross, VoiceWatch};
+use super::{FULL_EVERY, GENERATION_MASK, NO_TAG};
+use crate::dsp::coeffs::gain_to_db;
+use crate::dsp::pruning::{keep_most_energetic, Verdict, PRIOR};
+use crate::engine::voice::VoiceState;
+use crate::engine::Engine;
+
+impl Engine {
+    /// dB SPL of a unit amplitude at the output now: the playback level, through the output gain.
+    pub(super) fn calibration_db(&self) -> f32 {
+        self.controls.playback_level_db_spl + gain_to_db(self.smoothed.gain)
+    }
+
+    /// Pruning's share of a control tick: analyses on frame boundaries (and after input wakes).
+    pub(in crate::engine) fn prune_tick(&mut self, input_heard: bool) {
+        let cap = self.budget.cap(&self.controls, self.sample_rate_hz);
+        let wanted = self.controls.pruning || cap.is_some();
+        if !wanted && !self.pruner.engaged {
+            return;
+        }
+        let frame = frame_samples(self.controls.analysis_frame_ms, self.sample_rate_hz);
+        if !(self.clock.is_multiple_of(frame) || self.pruner.pending) {
+            return;
+        }
+        let start = self.pruner.profiling.then(Instant::now);
+        self.analyse(input_heard, cap);
+        if let Some(start) = start {
+            self.pruner.stats.analysis_ns += start.elapsed().as_nanos() as u64;
+        }
+    }
+
+    /// One analysis over every voice.
+    fn analyse(&mut self, input_heard: bool, cap: Option<usize>) {
+        let calibration_db = self.calibration_db();
+        let Engine {
+            pruner: p,
+            voices,
+            input_voice,
+            controls: c,
+            sample_rate_hz,
+            clock,
+            ..
+        } = self;
+        let (rate, now) = (*sample_rate_hz, *clock);
+        p.pending = false;
+        p.stats.analyses += 1;
+        let settings = (c.masking_offset_db, c.pruning, cap);
+        // A new calibration or setting changes every verdict (levels drift a little with the
+        // output gain's smoothing first).
+        let recheck_all =
+            p.settings != Some(settings) || (calibration_db - p.calibration_db).abs() > 0.5;
+        if recheck_all {
+            p.settings = Some(settings);
+            p.calibration_db = calibration_db;
+        }
+        let num_voices = voices.len();
+        let mut any_changed = false;
+        for (i, v) in voices.iter().chain(input_voice.as_ref()).enumerate() {
+            let watch = VoiceWatch::of(v);
+            if p.watch[i] != watch {
+                p.watch[i] = watch;
+                p.generation[i] = p.generation[i].wrapping_add(1) & GENERATION_MASK;
+                any_changed = true;
+            }
+            let strikes = (v.modes.num_started(), v.modes.num_woken());
+            p.struck[i] |= p.strikes[i] != strikes;
+            p.strikes[i] = strikes;
+        }
+        // A budget ranks everything heard, so it looks at everything.
+        let full = recheck_all || any_changed || cap.is_some() || p.since_full + 1 >= FULL_EVERY;
+        p.since_full = if full { 0 } else { p.since_full + 1 };
+        p.stats.full_analyses += full as u64;
+
+        // Steps 1-4 of seed 001's pseudo-code: the energies of the modes that may change state.
+        let reading = Reading::new(calibration_db, rate, cap.is_some());
+        let stride = p.cands.stride;
+        let mut engaged = false;
+        for (vi, v) in voices.iter_mut().chain(input_voice.as_mut()).enumerate() {
+            if v.state == VoiceState::Fading || v.modes.num_live() == 0 {
+                continue;
+            }
+            engaged |= v.modes.num_dormant() + v.modes.num_fading() > 0;
+            let is_input = vi == num_voices;
+            let idle = v.exciter.is_idle();
+            let driven = !idle || (is_input && input_heard);
+            let every_active = full || p.struck[vi];
+            // What the strikes under way add, at most (the seed adds the next frame's
+            // excitation energy).
+            let pulse = v.exciter.pending_bound();
+            let truncation_db =
+                c.truncation_db - 10.0 * (v.modes.num_started().max(1) as f32).log10();
+            p.truncation_db[vi] = truncation_db;
+            let generation = p.generation[vi];
+            let (cands, heard_until) = (&mut p.cands, &p.heard_until);
+            let wanted = |mode: usize, fading: bool| {
+                every_active || fading || driven || heard_until[vi * stride + mode] <= now
+            };
+            v.modes.for_each_active_where(wanted, |m| {
+                let locked = m.fading || driven;
+                let power = if driven {
+                    let amplitude = m.power.sqrt() + m.gain.abs() * pulse;
+                    amplitude * amplitude
+                } else {
+                    m.power
+                };
+                let flags = if locked { LOCKED } else { 0 };
+                cands.push(
+                    vi,
+                    generation,
+                    m.mode,
+                    crate::dsp::masking::power_to_db(power),
+                    m.theta,
+                    m.delta,
+                    flags,
+                    &reading,
+                );
+            });
+            let bank_now = v.modes.clock();
+            let due = if recheck_all || any_changed {
+                u64::MAX
+            } else {
+                bank_now
+            };
+            let generations = &p.generation;
+            v.modes.for_each_dormant(due, |d| {
+                let stale_tag = d.tag != NO_TAG && {
+                    let masker = (d.tag >> 24) as usize;
+                    generations
+                        .get(masker)
+                        .is_none_or(|&g| g != d.tag & GENERATION_MASK)
+                };
+                if !(recheck_all || stale_tag || d.recheck_at <= bank_now) {
+                    return;
+                }
+                // A driven voice cannot fade modes in: its dormant ones wait.
+                let flags = if idle && d.level_db < truncation_db {
+                    DORMANT | DROP
+                } else if driven {
+                    DORMANT | LOCKED
+                } else {
+                    DORMANT
+                };
+                cands.push(
+                    vi, generation, d.mode, d.level_db, d.theta, d.delta, flags, &reading,
+                );
+            });
+        }
+        let n = p.cands.len;
+        p.stats.candidates += n as u64;
+
+        // The maskers found before, at today's levels, unless their mode is looked at again or
+        // their voice has changed.
+        let num_prior = if full { 0 } else { p.gather_priors(now, None) };
+
+        // Steps 5-7: sort, threshold of hearing, masking.
+        let cd = &mut p.cands;
+        if c.pruning {
+            p.pass.run_after(
+                &p.prior_bark[..num_prior],
+                &p.prior_level_db[..num_prior],
+                &cd.level_db[..n],
+                &cd.bark[..n],
+                &cd.threshold_db[..n],
+                c.masking_offset_db,
+                &mut cd.verdicts[..n],
+                Some(&mut cd.envelope_db[..n]),
+            );
+        } else {
+            cd.verdicts[..n].fill(Verdict::Audible { masker: false });
+            cd.envelope_db[..n].fill(f32::NEG_INFINITY);
+        }
+
+        // The budget: keep the most energetic of what is audible.
+        if let Some(cap) = cap {
+            p.ranked.clear();
+            let mut locked = 0;
+            for i in 0..n {
+                let f = cd.flags[i];
+                if f & DROP != 0 || !(cd.verdicts[i].is_audible() || f & LOCKED != 0) {
+                    continue;
+                }
+                if f & LOCKED != 0 {
+                    locked += 1;
+                } else {
+                    p.ranked.push((cd.energy_db[i], i as u32));
+                }
+            }
+            let keep = cap.saturating_sub(locked);
+            if keep < p.ranked.len() {
+                keep_most_energetic(&mut p.ranked, keep);
+                for &(_, i) in &p.ranked[keep..] {
+                    cd.flags[i as usize] |= OVER_BUDGET;
+                }
+            }
+        }
+
+        // Switch modes off and on, and note when to look at each again.
+        for i in 0..n {
+            let f = p.cands.flags[i];
+            if f & LOCKED != 0 {
+                continue;
+            }
+            let (vi, mode) = p.cands.voice_mode(i);
+            let bank = if vi == num_voices {
+                match input_voice.as_mut() {
+                    Some(v) => &mut v.modes,
+                    None => continue,
+                }
+            } else {
+                &mut voices[vi].modes
+            };
+            if f & DROP != 0 {
+                bank.drop_dormant(mode);
+                p.stats.dropped += 1;
+                continue;
+            }
+            let fade = fade_samples(p.cands.theta[i], rate);
+            if p.cands.verdicts[i].is_audible() && f & OVER_BUDGET == 0 {
+                if f & DORMANT != 0 {
+                    bank.switch_on(mode, fade);
+                    p.stats.switched_on += 1;
+                } else {
+                    // Heard until its margin over the envelope has decayed away.
+                    let margin = p.cands.level_db[i] - p.cands.envelope_db[i];
+                    p.heard_until[vi * stride + mode] =
+                        now + samples_to_cross(margin, p.cands.fall_db[i]);
+                }
+                continue;
+            }
+            // Off: when to look again, and what to watch.
+            let (delay, tag, reason) = p.when_off(i, c.masking_offset_db, now);
+            p.off[vi * stride + mode] = reason;
+            let recheck_at = bank.clock() + delay;
+            if f & DORMANT != 0 {
+                bank.set_recheck(mode, recheck_at, tag);
+            } else {
+                bank.switch_off(mode, fade, recheck_at, tag);
+                p.stats.switched_off += 1;
+                engaged = true;
+            }
+        }
+
+        // The maskers to carry over: those handed in, then the new ones.
+        let cd = &mut p.cands;
+        if c.pruning {
+            let m = &mut p.maskers;
+            m.len = 0;
+            for jj in 0..num_prior {
+                m.move_entry(p.prior_entry[jj] as usize, m.len);
+                m.len += 1;
+            }
+            for &j in p.pass.maskers() {
+                if j & PRIOR == 0 {
+                    let i = j as usize;
+                    let voice = (cd.who[i] >> 24) as usize;
+                    m.push(
+                        cd.bark[i],
+                        cd.level_db[i],
+                        cd.fall_db[i],
+                        cd.who[i],
+                        p.generation[voice],
+                        now,
+                    );
+                }
+            }
+        } else {
+            p.maskers.len = 0;
+        }
+        p.stats.maskers += p.maskers.len as u64;
+        cd.clear();
+        p.struck.fill(false);
+        p.engaged = engaged;
+    }
+}
