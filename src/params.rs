@@ -2,19 +2,19 @@
 //! the engine's [`Controls`]. The ids never change once released.
 
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
-use std::sync::{Arc, RwLock};
+use std::sync::RwLock;
 
 use nice_plug::params::persist::PersistentField;
 use nice_plug::prelude::*;
 
 use crate::dsp::ExciterKind;
-use crate::engine::{
-    Controls, Material, VoiceModulation, ANALYSIS_FRAME_RANGE_MS, MASKING_OFFSET_RANGE_DB,
-    MATERIAL_Q_RANGE, MAX_MODE_BUDGET, MAX_POLYPHONY, MAX_TARGET_LOAD_PCT,
-    PLAYBACK_LEVEL_RANGE_DB_SPL,
-};
+use crate::engine::{Controls, Material, VoiceModulation, MATERIAL_Q_RANGE, MAX_POLYPHONY};
 use crate::model::factory::factory_bank;
 use crate::plugin::DEFAULT_FACTORY_BANK;
+
+mod pruning;
+
+pub use pruning::PruningParams;
 
 /// Polyphonic modulation ids (CLAP): a host can offset these parameters for one note alone.
 pub mod poly_id {
@@ -213,47 +213,9 @@ pub struct ModalParams {
     pub mpe: BoolParam,
     #[id = "mpebnd"]
     pub mpe_bend_range: FloatParam,
-    /// Perceptual pruning (seed 001): modes below the threshold of hearing or masked by louder
-    /// ones are not computed.
-    #[id = "prune"]
-    pub pruning: BoolParam,
-    /// Masking offset `a_v` in dB: larger prunes less.
-    #[id = "maskav"]
-    pub masking_offset: FloatParam,
-    /// Playback level: dB SPL of a full-scale sine, calibrating the pruning.
-    #[id = "spl"]
-    pub playback_level: FloatParam,
-    /// How often pruning looks at the modes, in ms.
-    #[id = "prfrm"]
-    pub analysis_frame: FloatParam,
-    /// Most modes computed at once, the most energetic kept; 0 = no cap.
-    #[id = "budget"]
-    pub mode_budget: IntParam,
-    /// Automatic budget: share of real time the synthesis may take, from the engine's measured
-    /// cost; 0 = off.
-    #[id = "load"]
-    pub target_load: FloatParam,
-}
-
-/// A value with its unit, or "off" at zero (budgets that are not in force).
-fn off_when_zero(v: f32, unit: &str) -> String {
-    if v <= 0.0 {
-        "off".to_string()
-    } else {
-        format!("{v:.0}{unit}")
-    }
-}
-
-/// Parses "off" as zero, else a number (a trailing unit is ignored).
-fn parse_off_or(s: &str) -> Option<f32> {
-    let s = s.trim();
-    if s.eq_ignore_ascii_case("off") {
-        return Some(0.0);
-    }
-    s.trim_end_matches(|c: char| !c.is_ascii_digit() && c != '.')
-        .trim()
-        .parse()
-        .ok()
+    /// Perceptual pruning and the mode budget.
+    #[nested(group = "Pruning")]
+    pub pruning: PruningParams,
 }
 
 fn percent(name: &str, default: f32) -> FloatParam {
@@ -406,51 +368,7 @@ impl ModalParams {
             )
             .with_unit(" st")
             .with_step_size(1.0),
-            pruning: BoolParam::new("Pruning", d.pruning),
-            masking_offset: decibels(
-                "Masking offset",
-                d.masking_offset_db,
-                MASKING_OFFSET_RANGE_DB.0,
-                MASKING_OFFSET_RANGE_DB.1,
-            ),
-            playback_level: decibels(
-                "Playback level",
-                d.playback_level_db_spl,
-                PLAYBACK_LEVEL_RANGE_DB_SPL.0,
-                PLAYBACK_LEVEL_RANGE_DB_SPL.1,
-            )
-            .with_unit(" dB SPL"),
-            analysis_frame: FloatParam::new(
-                "Pruning frame",
-                d.analysis_frame_ms,
-                FloatRange::Linear {
-                    min: ANALYSIS_FRAME_RANGE_MS.0,
-                    max: ANALYSIS_FRAME_RANGE_MS.1,
-                },
-            )
-            .with_unit(" ms")
-            .with_step_size(1.0),
-            mode_budget: IntParam::new(
-                "Mode budget",
-                d.mode_budget as i32,
-                IntRange::Linear {
-                    min: 0,
-                    max: MAX_MODE_BUDGET as i32,
-                },
-            )
-            .with_value_to_string(Arc::new(|v| off_when_zero(v as f32, "")))
-            .with_string_to_value(Arc::new(|s| parse_off_or(s).map(|v| v as i32))),
-            target_load: FloatParam::new(
-                "Target load",
-                d.target_load_pct,
-                FloatRange::Linear {
-                    min: 0.0,
-                    max: MAX_TARGET_LOAD_PCT,
-                },
-            )
-            .with_step_size(1.0)
-            .with_value_to_string(Arc::new(|v| off_when_zero(v, " %")))
-            .with_string_to_value(Arc::new(parse_off_or)),
+            pruning: PruningParams::new(&d),
         }
     }
 
@@ -541,12 +459,7 @@ impl ModalParams {
             width: self.width.value(),
             output_gain_db: self.output_gain.value(),
             input_gain_db: self.input_gain.value(),
-            pruning: self.pruning.value(),
-            masking_offset_db: self.masking_offset.value(),
-            playback_level_db_spl: self.playback_level.value(),
-            analysis_frame_ms: self.analysis_frame.value(),
-            mode_budget: self.mode_budget.value().max(0) as usize,
-            target_load_pct: self.target_load.value(),
+            ..self.pruning.apply(Controls::default())
         }
     }
 }

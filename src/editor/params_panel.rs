@@ -103,12 +103,12 @@ fn groups(p: &ModalParams, is_effect: bool) -> Vec<(&'static str, Vec<Control<'_
         (
             "Pruning",
             vec![
-                Bool(&p.pruning),
-                Float(&p.masking_offset),
-                Float(&p.playback_level),
-                Float(&p.analysis_frame),
-                Int(&p.mode_budget),
-                Float(&p.target_load),
+                Bool(&p.pruning.pruning),
+                Float(&p.pruning.masking_offset),
+                Float(&p.pruning.playback_level),
+                Float(&p.pruning.analysis_frame),
+                Int(&p.pruning.mode_budget),
+                Float(&p.pruning.target_load),
             ],
         ),
         ("Output", output),
