@@ -150,6 +150,9 @@ pub struct ModalParams {
     /// [`STATE_FORMAT`] of the state this was saved with.
     #[persist = "state-format"]
     pub state_format: AtomicU32,
+    /// The editor window's size in logical points, as the player left it (`None`: the default).
+    #[persist = "editor-size"]
+    pub editor_size: std::sync::RwLock<Option<(f32, f32)>>,
 
     #[id = "mat"]
     pub material: EnumParam<MaterialChoice>,
@@ -234,6 +237,7 @@ impl ModalParams {
         Self {
             bank: BankField::default(),
             state_format: AtomicU32::new(STATE_FORMAT),
+            editor_size: std::sync::RwLock::new(None),
             material: EnumParam::new("Material", MaterialChoice::Authored),
             material_q: FloatParam::new(
                 "Q",
