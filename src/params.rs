@@ -117,6 +117,11 @@ impl BankField {
         self.generation.fetch_add(1, Ordering::AcqRel);
     }
 
+    /// A copy of the bank's JSON (empty for the default bank).
+    pub fn json_text(&self) -> String {
+        self.json.read().unwrap_or_else(|e| e.into_inner()).clone()
+    }
+
     /// Puts back `json`, the bank still playing, in place of the text of `generation` that
     /// failed to load, so a saved project holds what was heard. Nothing changes if another bank
     /// has arrived since.

@@ -112,12 +112,7 @@ impl EditorApp {
             is_effect,
         } = links;
         let generation = params.bank.generation.load(Ordering::Acquire);
-        let json = params
-            .bank
-            .json
-            .read()
-            .map(|j| j.clone())
-            .unwrap_or_default();
+        let json = params.bank.json_text();
         let (bank, state_error) = match bank_from_state(&json) {
             Ok(bank) => (bank, None),
             Err(e) => (
