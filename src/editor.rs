@@ -20,10 +20,12 @@ mod mode_editor;
 mod mode_view;
 mod params_panel;
 mod session;
+mod slider;
 mod strike_pad;
 mod style;
+mod window_size;
 
-use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+use std::sync::atomic::{fence, AtomicU32, AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
 
@@ -35,6 +37,7 @@ use nice_plug_egui::{create_egui_editor, EguiEditor, EguiEditorState, EguiNiceSe
 pub use app::{BankErrorSource, EditorApp, EditorLayout};
 pub use mode_view::DB_SPAN as MODE_VIEW_DB_SPAN;
 pub use session::BankSession;
+pub use slider::control_rect;
 
 use crate::engine::{Engine, Note, NoteEvent, VoiceModulation};
 use crate::model::validate::MAX_MODES;
@@ -56,6 +59,9 @@ pub const MAX_METERED_MODES: usize = MAX_MODES;
 
 /// Strike-pad requests the queue holds until the audio thread takes them; more are dropped.
 const AUDITION_QUEUE: usize = 64;
+
+/// Times the GUI tries to copy the energies when publications keep tearing the copy.
+const READ_ATTEMPTS: usize = 4;
 
 /// Note id of the strike pad's notes, which the host never hears of (CLAP note ids are never
 /// negative).
@@ -147,6 +153,9 @@ pub struct EditorShared {
     energy_generation: AtomicU64,
     /// Incremented after every publication.
     serial: AtomicU64,
+    /// Odd while the audio thread writes the energies, incremented before and after: the GUI
+    /// keeps a copy only when it reads the same even value before and after copying.
+    energy_seq: AtomicU64,
     /// Samples until the next publication (audio thread only).
     countdown: AtomicU32,
     /// Strike-pad requests, GUI to audio thread.
@@ -178,6 +187,7 @@ impl EditorShared {
             energy_modes: AtomicU32::new(0),
             energy_generation: AtomicU64::new(0),
             serial: AtomicU64::new(0),
+            energy_seq: AtomicU64::new(0),
             countdown: AtomicU32::new(0),
             audition_tx,
             audition_rx,
@@ -235,6 +245,10 @@ impl EditorShared {
         let n = engine.bank().num_modes().min(self.energy.len());
         self.bank_modes
             .store(engine.bank().num_modes() as u32, Ordering::Relaxed);
+        let seq = self.energy_seq.load(Ordering::Relaxed);
+        self.energy_seq
+            .store(seq.wrapping_add(1), Ordering::Relaxed);
+        fence(Ordering::Release);
         for slot in &self.energy[..n] {
             slot.store(SILENT_BITS, Ordering::Relaxed);
         }
@@ -246,6 +260,8 @@ impl EditorShared {
         });
         self.energy_modes.store(n as u32, Ordering::Relaxed);
         self.energy_generation.store(generation, Ordering::Relaxed);
+        self.energy_seq
+            .store(seq.wrapping_add(2), Ordering::Release);
         self.serial.fetch_add(1, Ordering::Release);
     }
 
@@ -265,17 +281,32 @@ impl EditorShared {
     /// modes sounding nowhere. Returns `false` (and clears `out`) when the energies published
     /// belong to another bank.
     pub fn read_energies(&self, generation: u64, out: &mut Vec<Option<f32>>) -> bool {
-        out.clear();
-        self.serial.load(Ordering::Acquire);
-        if self.energy_generation.load(Ordering::Relaxed) != generation {
-            return false;
+        // A copy torn by a publication under way is read again; a GUI frame never waits long.
+        for _ in 0..READ_ATTEMPTS {
+            out.clear();
+            let before = self.energy_seq.load(Ordering::Acquire);
+            if before % 2 == 1 {
+                std::hint::spin_loop();
+                continue;
+            }
+            let same_bank = self.energy_generation.load(Ordering::Relaxed) == generation;
+            if same_bank {
+                let n = (self.energy_modes.load(Ordering::Relaxed) as usize).min(self.energy.len());
+                out.extend(self.energy[..n].iter().map(|slot| {
+                    let e = f32::from_bits(slot.load(Ordering::Relaxed));
+                    (e >= 0.0).then_some(e)
+                }));
+            }
+            fence(Ordering::Acquire);
+            if self.energy_seq.load(Ordering::Relaxed) == before {
+                if !same_bank {
+                    out.clear();
+                }
+                return same_bank;
+            }
         }
-        let n = self.energy_modes.load(Ordering::Relaxed) as usize;
-        out.extend(self.energy[..n].iter().map(|slot| {
-            let e = f32::from_bits(slot.load(Ordering::Relaxed));
-            (e >= 0.0).then_some(e)
-        }));
-        true
+        out.clear();
+        false
     }
 
     /// How many times meters were published so far.

@@ -121,6 +121,11 @@ impl BankField {
         self.generation.fetch_add(1, Ordering::AcqRel);
     }
 
+    /// A copy of the bank's JSON (empty for the default bank).
+    pub fn json_text(&self) -> String {
+        self.json.read().unwrap_or_else(|e| e.into_inner()).clone()
+    }
+
     /// Puts back `json`, the bank still playing, in place of the text of `generation` that
     /// failed to load, so a saved project holds what was heard. Nothing changes if another bank
     /// has arrived since.
@@ -154,6 +159,9 @@ pub struct ModalParams {
     /// [`STATE_FORMAT`] of the state this was saved with.
     #[persist = "state-format"]
     pub state_format: AtomicU32,
+    /// The editor window's size in logical points, as the player left it (`None`: the default).
+    #[persist = "editor-size"]
+    pub editor_size: std::sync::RwLock<Option<(f32, f32)>>,
 
     #[id = "mat"]
     pub material: EnumParam<MaterialChoice>,
@@ -241,6 +249,7 @@ impl ModalParams {
         Self {
             bank: BankField::default(),
             state_format: AtomicU32::new(STATE_FORMAT),
+            editor_size: std::sync::RwLock::new(None),
             material: EnumParam::new("Material", MaterialChoice::Authored),
             material_q: FloatParam::new(
                 "Q",

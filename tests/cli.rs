@@ -683,7 +683,7 @@ fn fit_rejects_bad_recordings_and_writes_nothing() {
     let out = run(dir.path(), &["fit", "silence.wav=top", "-o", "out.json"]);
     assert_failed_cleanly(
         &out,
-        &["top", "no strike found", "every sample is zero"],
+        &["silence.wav (top): no strike found", "every sample is zero"],
         dir.path(),
         &["notes.wav", "silence.wav", "surround.wav"],
     );
@@ -705,6 +705,54 @@ fn fit_rejects_bad_recordings_and_writes_nothing() {
         dir.path(),
         &["notes.wav", "silence.wav", "surround.wav"],
     );
+}
+
+#[test]
+fn fit_never_overwrites_a_recording_and_a_late_failure_writes_nothing() {
+    let dir = dir_with_bank();
+    write_strike_wav(&dir.path().join("edge.wav"), 1);
+    let original = std::fs::read(dir.path().join("edge.wav")).unwrap();
+    for (args, expected) in [
+        (
+            &[
+                "fit",
+                "edge.wav",
+                "-o",
+                "out.json",
+                "--report",
+                "./edge.wav",
+            ][..],
+            &["edge.wav", "the report would overwrite this recording"][..],
+        ),
+        (
+            &["fit", "edge.wav", "-o", "edge.wav"][..],
+            &["edge.wav", "the bank would overwrite this recording"][..],
+        ),
+        (
+            &[
+                "fit",
+                "edge.wav",
+                "-o",
+                "out.json",
+                "--report",
+                "./out.json",
+            ][..],
+            &["out.json", "the report and the bank would be the same file"][..],
+        ),
+        // The report cannot be put in place: the bank, staged first, is not written either.
+        (
+            &["fit", "edge.wav", "-o", "out.json", "--report", "late.txt/"][..],
+            &["late.txt", "cannot write"][..],
+        ),
+    ] {
+        let out = run(dir.path(), args);
+        assert_failed_cleanly(&out, expected, dir.path(), &["edge.wav"]);
+        assert_eq!(
+            std::fs::read(dir.path().join("edge.wav")).unwrap(),
+            original,
+            "{args:?} changed the recording"
+        );
+    }
 }
 
 #[test]
@@ -931,7 +979,7 @@ fn compress_merges_and_drops_and_reports() {
     );
     assert!(!bad.status.success());
     assert!(
-        stderr(&bad).contains("drop_below_db = 6"),
+        stderr(&bad).contains("--drop-below-db 6: expected"),
         "{}",
         stderr(&bad)
     );

@@ -11,6 +11,7 @@ use std::time::Duration;
 
 use egui::{pos2, vec2, Event, Key, Modifiers, Pos2, Rect};
 use harness::{at, Harness};
+use modal_resonator::editor::control_rect;
 use modal_resonator::editor::{
     Audition, EditorShared, EDITOR_MIN_SIZE, EDITOR_SIZE, METER_INTERVAL_S, MODE_VIEW_DB_SPAN,
 };
@@ -30,7 +31,7 @@ fn every_factory_bank_draws_at_every_size_and_scale() {
     for bank in factory_banks() {
         let mut h = Harness::new(Some(&bank));
         for size in sizes {
-            for pixels_per_point in [1.0, 2.0] {
+            for pixels_per_point in [1.0, 1.25, 2.0] {
                 h.size = size;
                 h.pixels_per_point = pixels_per_point;
                 h.settle();
@@ -76,20 +77,104 @@ fn every_factory_bank_draws_at_every_size_and_scale() {
 }
 
 #[test]
-fn every_parameter_has_a_labelled_control() {
-    let h = Harness::new(None);
-    let shown = h.app.shown_parameter_names();
-    for (_, ptr, _) in h.params.param_map() {
-        // SAFETY: the parameters live as long as `h`.
-        let name = unsafe { ptr.name() }.to_string();
-        let effect_only = name == h.params.dry_wet.name();
-        assert_eq!(
-            shown.contains(&name),
-            !effect_only,
-            "parameter {name:?} shown: {}",
-            shown.contains(&name)
-        );
+fn the_effect_editor_draws_at_every_size() {
+    let mut h = Harness::with_kind(None, true);
+    for size in [
+        vec2(EDITOR_MIN_SIZE.0, EDITOR_MIN_SIZE.1),
+        vec2(EDITOR_SIZE.0 as f32, EDITOR_SIZE.1 as f32),
+    ] {
+        h.size = size;
+        h.settle();
+        let screen = Rect::from_min_size(Pos2::ZERO, size);
+        let layout = h.app.layout();
+        assert!(screen.contains_rect(layout.mode_view) && screen.contains_rect(layout.strike_area));
+        let dry_wet = control_rect(&h.ctx, h.params.dry_wet.name()).expect("dry/wet is drawn");
+        assert!(dry_wet.width() > 50.0, "dry/wet at {dry_wet:?}");
     }
+}
+
+#[test]
+fn every_parameter_has_a_labelled_control() {
+    for is_effect in [false, true] {
+        let h = Harness::with_kind(None, is_effect);
+        let shown = h.app.shown_parameter_names();
+        for (_, ptr, _) in h.params.param_map() {
+            // SAFETY: the parameters live as long as `h`.
+            let name = unsafe { ptr.name() }.to_string();
+            assert!(shown.contains(&name), "parameter {name:?} has no control");
+        }
+    }
+}
+
+#[test]
+fn sliders_end_every_gesture_they_begin() {
+    let mut h = Harness::new(None);
+    let name = h.params.size.name().to_string();
+    let rect = control_rect(&h.ctx, &name).expect("the size slider is drawn");
+    let default = h.params.size.default_plain_value();
+
+    // A drag moves the value by the distance dragged, not to the pointer.
+    let from = at(rect, 0.5, 0.5);
+    let before = h.params.size.unmodulated_normalized_value();
+    h.drag(
+        from,
+        from + vec2(rect.width() * 0.2, 0.0),
+        4,
+        Modifiers::NONE,
+    );
+    let after = h.params.size.unmodulated_normalized_value();
+    assert!(
+        (after - before - 0.2).abs() < 0.02,
+        "dragged a fifth of the width: {before} -> {after}"
+    );
+    assert!(h.gestures_balanced());
+
+    // Shift moves it a tenth as far.
+    let before = after;
+    h.drag(
+        from,
+        from + vec2(rect.width() * 0.2, 0.0),
+        4,
+        Modifiers::SHIFT,
+    );
+    let after = h.params.size.unmodulated_normalized_value();
+    assert!(
+        (after - before - 0.02).abs() < 0.005,
+        "fine drag of a fifth of the width: {before} -> {after}"
+    );
+    assert!(h.gestures_balanced());
+
+    // A plain click changes nothing and leaves no gesture open.
+    h.click(at(rect, 0.9, 0.5));
+    assert_eq!(h.params.size.unmodulated_normalized_value(), after);
+    assert!(h.gestures_balanced());
+
+    // A double-click resets, in balanced gestures.
+    let p = at(rect, 0.9, 0.5);
+    h.move_to(p);
+    for _ in 0..2 {
+        h.button(p, true, Modifiers::NONE);
+        h.button(p, false, Modifiers::NONE);
+    }
+    h.settle();
+    assert_eq!(h.params.size.value(), default);
+    assert!(h.gestures_balanced());
+
+    // So does a Ctrl-click.
+    h.drag(
+        from,
+        from + vec2(rect.width() * 0.3, 0.0),
+        3,
+        Modifiers::NONE,
+    );
+    assert_ne!(h.params.size.value(), default);
+    h.frame(vec![Event::ModifiersChanged(Modifiers::COMMAND)]);
+    h.button(p, true, Modifiers::COMMAND);
+    h.button(p, false, Modifiers::COMMAND);
+    h.frame(vec![Event::ModifiersChanged(Modifiers::NONE)]);
+    h.settle();
+    assert_eq!(h.params.size.value(), default);
+    assert!(h.gestures_balanced());
 }
 
 #[test]
@@ -430,4 +515,38 @@ fn meters_are_published_at_the_meter_interval() {
     assert!(shared.read_energies(7, &mut energies));
     assert_eq!(energies.len(), bank.modes.len());
     assert!(!shared.read_energies(8, &mut energies));
+}
+
+#[test]
+fn the_window_opens_at_the_size_it_was_left_at() {
+    // A fresh project: nothing to restore; the size the window has is recorded.
+    let resizes = |h: &Harness| -> Vec<egui::ViewportCommand> {
+        h.commands
+            .iter()
+            .filter(|c| matches!(c, egui::ViewportCommand::InnerSize(_)))
+            .cloned()
+            .collect()
+    };
+    let mut h = Harness::new(None);
+    assert!(resizes(&h).is_empty(), "{:?}", h.commands);
+    let default = (EDITOR_SIZE.0 as f32, EDITOR_SIZE.1 as f32);
+    assert_eq!(*h.params.editor_size.read().unwrap(), Some(default));
+    h.size = vec2(1000.0, 700.0);
+    h.settle();
+    assert_eq!(*h.params.editor_size.read().unwrap(), Some((1000.0, 700.0)));
+
+    // A project saved with the window at 1000 x 700: the editor asks for that size on opening,
+    // and records nothing until the host has applied it.
+    let saved = h.params.editor_size.read().unwrap().unwrap();
+    let mut h = Harness::with_size(None, saved);
+    assert_eq!(
+        resizes(&h),
+        [egui::ViewportCommand::InnerSize(vec2(1000.0, 700.0))]
+    );
+    assert_eq!(*h.params.editor_size.read().unwrap(), Some(saved));
+    h.size = vec2(1000.0, 700.0);
+    h.settle();
+    h.size = vec2(1300.0, 800.0);
+    h.settle();
+    assert_eq!(*h.params.editor_size.read().unwrap(), Some((1300.0, 800.0)));
 }

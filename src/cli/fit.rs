@@ -4,8 +4,8 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use modal_resonator::model::fit::{fit_bank, read_wav_recording, save_report_file, FitOptions};
-use modal_resonator::model::save_bank_file;
+use modal_resonator::model::fit::{fit_bank, read_wav_recording, stage_report_file, FitOptions};
+use modal_resonator::model::{commit_all, stage_bank_file};
 
 use super::{check_output_dir, same_file};
 
@@ -54,22 +54,33 @@ pub(super) struct FitArgs {
 }
 
 /// `fit`: reads every recording, fits, writes the bank (and the report if asked) and prints the
-/// report. Nothing is written on failure.
+/// report. Nothing is written on failure: both files are staged before either is put in place.
 pub(super) fn run(args: &FitArgs) -> Result<(), String> {
     check_output_dir(&args.output)?;
+    if let Some(report) = &args.report {
+        check_output_dir(report)?;
+        if same_file(report, &args.output) {
+            return Err(format!(
+                "{}: the report and the bank would be the same file; name another --report",
+                report.display()
+            ));
+        }
+    }
     let mut recordings = Vec::with_capacity(args.recordings.len());
     for arg in &args.recordings {
         let (path, position) = split_recording_arg(arg);
-        if same_file(&path, &args.output) {
-            return Err(format!(
-                "{}: the output would overwrite an input",
-                args.output.display()
-            ));
+        for (output, what) in [
+            (Some(&args.output), "bank"),
+            (args.report.as_ref(), "report"),
+        ] {
+            if output.is_some_and(|output| same_file(&path, output)) {
+                return Err(format!(
+                    "{}: the {what} would overwrite this recording; write it elsewhere",
+                    path.display()
+                ));
+            }
         }
         recordings.push(read_wav_recording(&path, &position).map_err(|e| e.to_string())?);
-    }
-    if let Some(report) = &args.report {
-        check_output_dir(report)?;
     }
     let name = args.name.clone().unwrap_or_else(|| {
         args.output
@@ -90,11 +101,14 @@ pub(super) fn run(args: &FitArgs) -> Result<(), String> {
     let mut fit = fit_bank(&recordings, &options).map_err(|e| e.to_string())?;
     fit.bank.author = args.author.clone();
     fit.bank.license = args.license.clone();
-    save_bank_file(&fit.bank, &args.output).map_err(|e| e.to_string())?;
+    let cannot_write = |path: &std::path::Path, e: std::io::Error| {
+        format!("{}: cannot write: {e}", path.display())
+    };
+    let mut files = vec![stage_bank_file(&fit.bank, &args.output).map_err(|e| e.to_string())?];
     if let Some(path) = &args.report {
-        save_report_file(&fit.report, path)
-            .map_err(|e| format!("{}: cannot write the report: {e}", path.display()))?;
+        files.push(stage_report_file(&fit.report, path).map_err(|e| cannot_write(path, e))?);
     }
+    commit_all(files).map_err(|(path, e)| cannot_write(&path, e))?;
     print!("{}", fit.report);
     for r in &fit.report.recordings {
         for w in &r.warnings {

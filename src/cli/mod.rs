@@ -133,10 +133,21 @@ pub(super) fn check_output_dir(output: &Path) -> Result<(), String> {
     }
 }
 
-/// Whether `a` and `b` name the same existing file.
+/// Whether `a` and `b` name the same file, whether it exists yet or is still to be written
+/// (`out.json` and `./out.json` are the same).
 pub(super) fn same_file(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
+    let resolve = |p: &Path| -> Option<std::path::PathBuf> {
+        if let Ok(path) = p.canonicalize() {
+            return Some(path);
+        }
+        let dir = match p.parent() {
+            Some(dir) if !dir.as_os_str().is_empty() => dir,
+            _ => Path::new("."),
+        };
+        Some(dir.canonicalize().ok()?.join(p.file_name()?))
+    };
+    match (resolve(a), resolve(b)) {
+        (Some(a), Some(b)) => a == b,
+        _ => a == b,
     }
 }

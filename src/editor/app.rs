@@ -17,6 +17,7 @@ use super::meters::Meters;
 use super::mode_view::{ModeView, ViewInput};
 use super::session::BankSession;
 use super::strike_pad::StrikePad;
+use super::window_size::WindowSize;
 use super::{bank_info, mode_editor, params_panel, style};
 use super::{Audition, EditorLinks, EditorShared, MeterReading, METER_INTERVAL_S};
 use crate::model::summary::BankSummary;
@@ -97,6 +98,8 @@ pub struct EditorApp {
     last_time_s: Option<f64>,
     /// Whether the context has the editor's look.
     styled: bool,
+    /// The window's size, saved with the project.
+    window: WindowSize,
 }
 
 impl EditorApp {
@@ -109,12 +112,7 @@ impl EditorApp {
             is_effect,
         } = links;
         let generation = params.bank.generation.load(Ordering::Acquire);
-        let json = params
-            .bank
-            .json
-            .read()
-            .map(|j| j.clone())
-            .unwrap_or_default();
+        let json = params.bank.json_text();
         let (bank, state_error) = match bank_from_state(&json) {
             Ok(bank) => (bank, None),
             Err(e) => (
@@ -140,6 +138,7 @@ impl EditorApp {
             summary: None,
             last_time_s: None,
             styled: false,
+            window: WindowSize::new(),
         }
     }
 
@@ -204,7 +203,7 @@ impl EditorApp {
 
     /// The names of the parameters the parameter panel shows.
     pub fn shown_parameter_names(&self) -> Vec<String> {
-        params_panel::shown_names(&self.params, self.is_effect)
+        params_panel::shown_names(&self.params)
     }
 
     /// The user bank folder.
@@ -264,9 +263,9 @@ impl EditorApp {
             .default_size(side_width)
             .size_range(side_range.clone())
             .show(ui, |ui| {
-                ScrollArea::vertical().id_salt("parameters").show(ui, |ui| {
-                    params_panel::show(ui, &params, setter, self.is_effect, side_width)
-                });
+                ScrollArea::vertical()
+                    .id_salt("parameters")
+                    .show(ui, |ui| params_panel::show(ui, &params, setter, side_width));
             });
         let mut loaded = None;
         Panel::right("bank")
@@ -292,6 +291,7 @@ impl EditorApp {
         }
         self.push_bank();
         flow::resize_corner(ui);
+        self.window.update(ui, &self.params.editor_size);
         ui.ctx()
             .request_repaint_after(Duration::from_secs_f32(METER_INTERVAL_S));
     }
@@ -404,6 +404,7 @@ impl NiceEguiApp for EditorApp {
         style::apply(&egui_ctx);
         self.styled = true;
         self.gui_context = Some(nice_gui_ctx);
+        self.window.reopen();
         Ok(())
     }
 

@@ -74,16 +74,17 @@ impl Meters {
             bar(ui, r.voices as f32 / polyphony.max(1) as f32, false);
             ui.label(format!("{} / {polyphony}", r.voices));
             ui.separator();
-            ui.label("Modes computed");
-            let per_voice = r.computed_modes as f32 / r.voices.max(1) as f32;
+            ui.label("Modes");
+            let per_voice = r.live_modes as f32 / r.voices.max(1) as f32;
             bar(ui, per_voice / r.bank_modes.max(1) as f32, false);
             ui.label(format!(
-                "{} ({} live) · bank {} modes",
-                r.computed_modes, r.live_modes, r.bank_modes
+                "{} live · {} computed · bank {}",
+                r.live_modes, r.computed_modes, r.bank_modes
             ))
             .on_hover_text(
-                "Modes advanced per sample over all voices (live modes plus padding to whole \
-                 SIMD rows); the bar compares one voice's share with the bank's modes",
+                "Live: modes sounding over all voices. Computed: modes the resonators advance \
+                 per sample (live modes plus padding to whole SIMD rows). The bar compares one \
+                 voice's live modes with the bank's",
             );
             ui.separator();
             ui.label("Output");

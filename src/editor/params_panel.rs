@@ -1,11 +1,12 @@
-//! Every host parameter as a labelled control with its value and unit, in groups. Sliders reset
-//! on double-click (or Ctrl-click), move finely with Shift held, and take typed values when their
-//! value is clicked; they read the parameters every frame, so host automation moves them live.
+//! Every host parameter as a labelled control with its value and unit, in groups. Sliders
+//! ([`super::slider`]) reset on double-click (or Ctrl-click), move finely with Shift held, and take
+//! typed values when their value is clicked; they read the parameters every frame, so host
+//! automation moves them live.
 
 use egui::{CollapsingHeader, ComboBox, Grid, Ui};
 use nice_plug::prelude::{BoolParam, Enum, EnumParam, FloatParam, IntParam, Param, ParamSetter};
-use nice_plug_egui::widgets::ParamSlider;
 
+use super::slider::param_slider;
 use crate::params::ModalParams;
 
 /// Room the label and value columns need beside a slider, in points.
@@ -52,12 +53,10 @@ impl<T: Enum + PartialEq + 'static> ChoiceParam for EnumParam<T> {
 }
 
 /// The groups and their controls, in display order.
-fn groups(p: &ModalParams, is_effect: bool) -> Vec<(&'static str, Vec<Control<'_>>)> {
+fn groups(p: &ModalParams) -> Vec<(&'static str, Vec<Control<'_>>)> {
     use Control::*;
-    let mut output = vec![Float(&p.output_gain), Float(&p.width)];
-    if is_effect {
-        output.push(Float(&p.dry_wet));
-    }
+    // The instrument's dry/wet mixes its exciter input, the effect's its audio input.
+    let output = vec![Float(&p.output_gain), Float(&p.width), Float(&p.dry_wet)];
     vec![
         (
             "Object",
@@ -125,8 +124,8 @@ fn groups(p: &ModalParams, is_effect: bool) -> Vec<(&'static str, Vec<Control<'_
 }
 
 /// The names of every parameter the panel shows, in order (for tests).
-pub fn shown_names(params: &ModalParams, is_effect: bool) -> Vec<String> {
-    groups(params, is_effect)
+pub fn shown_names(params: &ModalParams) -> Vec<String> {
+    groups(params)
         .iter()
         .flat_map(|(_, controls)| controls.iter().map(control_name))
         .collect()
@@ -143,20 +142,14 @@ fn control_name(c: &Control) -> String {
 
 /// Draws the parameter groups in a panel `panel_width` points wide (the width the panel starts
 /// with: sizing the sliders by the width left would let the panel creep frame by frame).
-pub fn show(
-    ui: &mut Ui,
-    params: &ModalParams,
-    setter: &ParamSetter,
-    is_effect: bool,
-    panel_width: f32,
-) {
+pub fn show(ui: &mut Ui, params: &ModalParams, setter: &ParamSetter, panel_width: f32) {
     let width = (panel_width - LABEL_AND_VALUE_WIDTH).clamp(SLIDER_WIDTH.0, SLIDER_WIDTH.1);
     ui.label(
         egui::RichText::new("Double-click resets · Shift-drag fine · click a value to type")
             .small()
             .weak(),
     );
-    for (group, controls) in groups(params, is_effect) {
+    for (group, controls) in groups(params) {
         CollapsingHeader::new(group)
             .default_open(true)
             .show(ui, |ui| {
@@ -176,12 +169,8 @@ pub fn show(
 
 fn show_control(ui: &mut Ui, control: &Control, setter: &ParamSetter, width: f32) {
     match control {
-        Control::Float(p) => {
-            ui.add(ParamSlider::for_param(*p, setter).with_width(width));
-        }
-        Control::Int(p) => {
-            ui.add(ParamSlider::for_param(*p, setter).with_width(width));
-        }
+        Control::Float(p) => param_slider(ui, *p, setter, width),
+        Control::Int(p) => param_slider(ui, *p, setter, width),
         Control::Bool(p) => {
             let mut on = p.value();
             let text = if on { "On" } else { "Off" };

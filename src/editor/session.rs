@@ -44,6 +44,8 @@ pub struct BankSession {
     order: Vec<usize>,
     /// The positions, normalised as the engine does.
     positions: PositionMap,
+    /// Whether any mode is soloed (kept, as every mode asks on every frame).
+    any_soloed: bool,
     /// Earlier states, oldest first.
     undo: Vec<Snapshot>,
     /// States undone, most recent last.
@@ -73,6 +75,7 @@ impl BankSession {
             origin: origin.into(),
             order: Vec::new(),
             positions: PositionMap::new(&[]),
+            any_soloed: false,
             undo: Vec::new(),
             redo: Vec::new(),
             gesture_open: false,
@@ -142,7 +145,7 @@ impl BankSession {
 
     /// Whether mode `i` is heard: soloed when any mode is, else not muted.
     pub fn is_audible(&self, i: usize) -> bool {
-        if self.now.soloed.iter().any(|&s| s) {
+        if self.any_soloed {
             self.is_soloed(i)
         } else {
             !self.is_muted(i)
@@ -349,6 +352,7 @@ impl BankSession {
             .map(|p| p.coords.clone())
             .collect();
         self.positions = PositionMap::new(&coords);
+        self.any_soloed = self.now.soloed.iter().any(|&s| s);
         self.version += 1;
     }
 }

@@ -35,7 +35,7 @@ use serde_json::{json, Map};
 
 pub use error::FitError;
 pub use fidelity::{resynthesize, Fidelity};
-pub use report::{save_report_file, FitReport, ModeReport, RecordingReport};
+pub use report::{save_report_file, stage_report_file, FitReport, ModeReport, RecordingReport};
 pub use wav::read_wav_recording;
 
 use self::analyse::{analyse, prepare, Analysis};
@@ -59,13 +59,18 @@ pub struct Recording {
     pub sample_rate_hz: u32,
     /// Notes about how the samples were read (for example a stereo mix), passed to the report.
     pub notes: Vec<String>,
+    /// Where the recording came from, for error messages: its file and position name, or the
+    /// position name alone for a recording made in memory.
+    pub origin: String,
 }
 
 impl Recording {
     /// A mono recording with no notes.
     pub fn new(name: impl Into<String>, samples: Vec<f32>, sample_rate_hz: u32) -> Self {
+        let name = name.into();
         Self {
-            name: name.into(),
+            origin: name.clone(),
+            name,
             samples,
             sample_rate_hz,
             notes: Vec::new(),
@@ -143,8 +148,8 @@ impl FitOptions {
         }
         if !(self.window_s.is_finite() && (0.005..=2.0).contains(&self.window_s)) {
             return bad(format!(
-                "window {} s: expected 0.005 s to 2 s",
-                self.window_s
+                "--window-ms {}: expected 5 ms to 2000 ms",
+                self.window_s * 1e3
             ));
         }
         if !(self.max_seconds.is_finite() && self.max_seconds > 0.0) {

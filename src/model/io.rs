@@ -7,7 +7,7 @@
 
 use std::fmt;
 use std::fs;
-use std::io::{self, Write};
+use std::io;
 use std::path::Path;
 
 use serde::de::{self, DeserializeSeed, MapAccess, SeqAccess, Visitor};
@@ -15,6 +15,7 @@ use serde::Deserialize;
 use serde_json::{Map, Value};
 
 use super::bank::Bank;
+use super::staged::StagedFile;
 use super::validate::{self, Problem, Problems, MAX_REPORTED_PROBLEMS};
 
 /// Why a bank could not be loaded or saved. `Display` prints one line per problem, each starting
@@ -189,33 +190,22 @@ pub fn load_bank_file(path: &Path) -> Result<Bank, BankError> {
 /// atomically: the JSON goes to a temporary file in the same directory, which is then renamed
 /// over `path`; on any failure `path` is left as it was and the temporary file is removed.
 pub fn save_bank_file(bank: &Bank, path: &Path) -> Result<(), BankError> {
+    stage_bank_file(bank, path)?
+        .commit()
+        .map_err(|error| BankError::io(&path.display().to_string(), "cannot replace", error))
+}
+
+/// Validates `bank` and writes its JSON to a temporary file beside `path`, to replace `path`
+/// when committed ([`save_bank_file`] in two steps, for commands writing several files).
+pub fn stage_bank_file(bank: &Bank, path: &Path) -> Result<StagedFile, BankError> {
     let origin = path.display().to_string();
     let mut problems = Problems::new(MAX_REPORTED_PROBLEMS);
     validate::check_bank(bank, &mut problems);
     if !problems.is_empty() {
         return Err(BankError::invalid(&origin, problems));
     }
-
-    let json = bank_to_json(bank);
-    let dir = match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".modal-bank-").suffix(".tmp");
-    // tempfile's default is owner-only; a saved preset gets the usual umask-based permissions.
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let mut file = builder
-        .tempfile_in(dir)
-        .map_err(|error| BankError::io(&origin, "cannot create a temporary file", error))?;
-    // Dropping `file` on an early return deletes the temporary file.
-    file.write_all(json.as_bytes())
-        .and_then(|()| file.as_file().sync_all())
-        .map_err(|error| BankError::io(&origin, "cannot write", error))?;
-    file.persist(path)
-        .map_err(|error| BankError::io(&origin, "cannot replace", error.error))?;
-    Ok(())
+    StagedFile::write(path, "modal-bank", bank_to_json(bank).as_bytes())
+        .map_err(|error| BankError::io(&origin, "cannot write", error))
 }
 
 /// The bank as pretty-printed JSON: fields in the order of the Rust types, each float printed with

@@ -11,9 +11,13 @@ pub mod limen;
 pub mod materials;
 pub mod schema;
 pub mod shapes;
+pub mod staged;
 pub mod summary;
 pub mod validate;
 
 pub use bank::{Bank, BankDefaults, Mode, Position};
-pub use io::{load_bank_file, parse_bank_str, save_bank_file, BankError, BankErrorKind};
+pub use io::{
+    load_bank_file, parse_bank_str, save_bank_file, stage_bank_file, BankError, BankErrorKind,
+};
+pub use staged::{commit_all, StagedFile};
 pub use validate::Problem;

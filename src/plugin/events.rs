@@ -277,14 +277,7 @@ impl<K: Kind> ModalPlugin<K> {
         while let Some(audition) = self.editor_shared.next_audition() {
             let key = match audition {
                 Audition::Strike { .. } => {
-                    let root = self
-                        .engines
-                        .current
-                        .as_ref()
-                        .map_or(60.0, |e| e.bank().root_key);
-                    let key = self
-                        .last_key
-                        .unwrap_or(root.round().clamp(0.0, 127.0) as u8);
+                    let key = self.strike_key();
                     self.audition_key = Some(key);
                     key
                 }

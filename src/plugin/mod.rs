@@ -149,19 +149,24 @@ impl<K: Kind> ModalPlugin<K> {
         self.shared.bank_error.read().ok().and_then(|e| e.clone())
     }
 
-    /// Adds a strike at each onset of `self.input[..n]` (trigger mode) to the segment's events,
-    /// keeping them in time order.
-    fn add_onsets(&mut self, n: usize) {
-        let threshold = util::db_to_gain(self.params.trigger_threshold.value());
-        let retrigger_s = self.params.retrigger.value() * 1e-3;
+    /// The key of strikes that come without one (onsets, the editor's strike pad): the last key
+    /// played, else the bank's root.
+    fn strike_key(&self) -> u8 {
         let root = self
             .engines
             .current
             .as_ref()
             .map_or(60.0, |e| e.bank().root_key);
-        let key = self
-            .last_key
-            .unwrap_or(root.round().clamp(0.0, 127.0) as u8);
+        self.last_key
+            .unwrap_or(root.round().clamp(0.0, 127.0) as u8)
+    }
+
+    /// Adds a strike at each onset of `self.input[..n]` (trigger mode) to the segment's events,
+    /// keeping them in time order.
+    fn add_onsets(&mut self, n: usize) {
+        let threshold = util::db_to_gain(self.params.trigger_threshold.value());
+        let retrigger_s = self.params.retrigger.value() * 1e-3;
+        let key = self.strike_key();
         let events = &mut self.segment_events;
         self.onsets
             .process(&self.input[..n], threshold, retrigger_s, |onset| {
@@ -335,12 +340,7 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
             if params.bank.generation.load(Ordering::Acquire) != generation {
                 return;
             }
-            let json = params
-                .bank
-                .json
-                .read()
-                .map(|j| j.clone())
-                .unwrap_or_default();
+            let json = params.bank.json_text();
             match bank_from_state(&json) {
                 Ok(bank) => {
                     let rate = f32::from_bits(shared.sample_rate_bits.load(Ordering::Acquire));
@@ -399,13 +399,7 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         self.onsets = OnsetDetector::new(rate);
         // Build the engine here, synchronously, so offline renders start with the right bank.
         let generation = self.params.bank.generation.load(Ordering::Acquire);
-        let json = self
-            .params
-            .bank
-            .json
-            .read()
-            .map(|j| j.clone())
-            .unwrap_or_default();
+        let json = self.params.bank.json_text();
         let bank = match bank_from_state(&json) {
             Ok(bank) => {
                 set_error(&self.shared, None);

@@ -68,12 +68,30 @@ pub struct Harness {
     pub time_s: f64,
     /// The user bank folder.
     pub dir: tempfile::TempDir,
+    /// Every command the editor sent its window, oldest first.
+    pub commands: Vec<egui::ViewportCommand>,
 }
 
 impl Harness {
     /// An instrument's editor playing `bank` (the default bank when `None`).
     pub fn new(bank: Option<&Bank>) -> Self {
-        let params = Arc::new(ModalParams::new(false));
+        Self::build(bank, false, None)
+    }
+
+    /// An instrument's editor in a project saved with the window at `size` (logical points),
+    /// opening at the default size.
+    pub fn with_size(bank: Option<&Bank>, size: (f32, f32)) -> Self {
+        Self::build(bank, false, Some(size))
+    }
+
+    /// The editor of the effect (`is_effect`) or the instrument, playing `bank`.
+    pub fn with_kind(bank: Option<&Bank>, is_effect: bool) -> Self {
+        Self::build(bank, is_effect, None)
+    }
+
+    fn build(bank: Option<&Bank>, is_effect: bool, saved_size: Option<(f32, f32)>) -> Self {
+        let params = Arc::new(ModalParams::new(is_effect));
+        *params.editor_size.write().unwrap() = saved_size;
         if let Some(bank) = bank {
             params.bank.replace(bank_to_json(bank));
         }
@@ -83,7 +101,7 @@ impl Harness {
             params: params.clone(),
             shared: shared.clone(),
             bank_error: Arc::new(|| None),
-            is_effect: false,
+            is_effect,
         })
         .with_user_dir(dir.path().join("banks"));
         let mut h = Self {
@@ -96,6 +114,7 @@ impl Harness {
             pixels_per_point: 1.0,
             time_s: 0.0,
             dir,
+            commands: Vec::new(),
         };
         h.settle();
         h
@@ -124,6 +143,9 @@ impl Harness {
             .tessellate(output.shapes.clone(), output.pixels_per_point);
         assert!(!primitives.is_empty(), "nothing to paint");
         output.textures_delta.clear();
+        for viewport in output.viewport_output.values() {
+            self.commands.extend(viewport.commands.iter().cloned());
+        }
         output
     }
 

@@ -22,13 +22,7 @@ impl EditorApp {
         if generation == self.session.generation() {
             return;
         }
-        let json = self
-            .params
-            .bank
-            .json
-            .read()
-            .map(|j| j.clone())
-            .unwrap_or_default();
+        let json = self.params.bank.json_text();
         match bank_from_state(&json) {
             Ok(bank) => {
                 self.session = BankSession::new(bank, "Plugin state", generation);

@@ -97,7 +97,7 @@ impl fmt::Display for CompressError {
                 name,
                 value,
                 expected,
-            } => write!(f, "{name} = {value}: expected {expected}"),
+            } => write!(f, "{name} {value}: expected {expected}"),
             Self::Invalid(problems) => {
                 write!(f, "the compressed bank is not valid:")?;
                 for problem in problems {
@@ -116,14 +116,14 @@ impl CompressOptions {
     pub fn check(&self) -> Result<(), CompressError> {
         if !(self.limen_scale.is_finite() && self.limen_scale >= 0.0) {
             return Err(CompressError::BadOption {
-                name: "limen_scale",
+                name: "--limen-scale",
                 value: self.limen_scale,
                 expected: "a number 0 or above",
             });
         }
         match self.drop_below_db {
             Some(db) if !(db.is_finite() && db <= 0.0) => Err(CompressError::BadOption {
-                name: "drop_below_db",
+                name: "--drop-below-db",
                 value: db,
                 expected: "a level in dB, 0 or below",
             }),

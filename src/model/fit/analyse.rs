@@ -15,9 +15,8 @@ use super::onset::{find_strike, Strike};
 use super::peaks::vote;
 use super::stft::{hann, Spectrogram};
 use super::track::{track, Track};
-use super::warnings::input_warnings;
+use super::warnings::{check_clipping, input_warnings};
 use super::{FitError, FitOptions, Recording};
-use crate::model::limen::difference_limen_hz;
 
 /// Lowest sample rate analysed, in Hz.
 pub const MIN_SAMPLE_RATE_HZ: u32 = 8_000;
@@ -134,7 +133,8 @@ pub fn analyse(recording: &Recording, options: &FitOptions) -> Result<Analysis, 
 /// Checks `recording`, finds its strike and noise floor, and warns of clipping and noise; finds
 /// no modes yet.
 pub fn prepare(recording: &Recording, options: &FitOptions) -> Result<Analysis, FitError> {
-    let name = recording.name.clone();
+    // Errors name the file as well as the position.
+    let name = recording.origin.clone();
     let rate_hz = recording.sample_rate_hz;
     if rate_hz < MIN_SAMPLE_RATE_HZ {
         return Err(FitError::SampleRate {
@@ -154,6 +154,7 @@ pub fn prepare(recording: &Recording, options: &FitOptions) -> Result<Analysis, 
         name: name.clone(),
         detail,
     })?;
+    check_clipping(recording, &strike, &name)?;
     let max_len = (options.max_seconds * rate) as usize;
     let end = strike.end.min(strike.onset + max_len);
     let sound_len = end - strike.onset;
@@ -178,7 +179,7 @@ pub fn prepare(recording: &Recording, options: &FitOptions) -> Result<Analysis, 
     let whole = Spectrogram::new(&x, rate, window_len, hop, PAD);
     let noise = NoiseSpectrum::estimate(&whole, window_sums.0);
     Ok(Analysis {
-        name,
+        name: recording.name.clone(),
         sample_rate_hz: rate,
         signal: x[strike.onset..end].to_vec(),
         start: (START_SKIP_S * rate).round() as usize,
@@ -196,12 +197,13 @@ pub fn prepare(recording: &Recording, options: &FitOptions) -> Result<Analysis, 
 /// The rounds of voting, tracking and joint fitting.
 fn find_modes(a: &mut Analysis, min_hz: f64, max_hz: f64, max_candidates: usize) {
     let rate = a.sample_rate_hz;
+    let bin_hz = rate / a.window_len as f64;
     let first = candidates(a, &a.signal, min_hz, max_hz, max_candidates, &[]);
     let mut modes: Vec<Found> = first
         .into_iter()
         .filter_map(|f| track_in(a, &a.signal, f, a.window_len))
         .collect();
-    dedupe(&mut modes);
+    dedupe(&mut modes, bin_hz);
     for round in 0..ROUNDS {
         let shapes = shapes_of(&modes);
         let amplitudes = a.amplitudes(&shapes);
@@ -245,7 +247,7 @@ fn find_modes(a: &mut Analysis, min_hz: f64, max_hz: f64, max_candidates: usize)
             .collect();
         modes = tracked;
         modes.extend(hidden);
-        dedupe(&mut modes);
+        dedupe(&mut modes, bin_hz);
     }
     let shapes = shapes_of(&modes);
     let amplitudes = a.amplitudes(&shapes);
@@ -337,14 +339,17 @@ fn track_in(a: &Analysis, signal: &[f64], freq_hz: f64, len: usize) -> Option<Fo
     })
 }
 
-/// Sorts `modes` by frequency and keeps the stronger of any two closer than the difference
-/// limen: the same mode found twice.
-fn dedupe(modes: &mut Vec<Found>) {
+/// Sorts `modes` by frequency and keeps the stronger of any two closer than one analysis bin:
+/// the same mode found twice (the window cannot tell such a pair apart, so the track of the
+/// stronger already holds both). Pairs the window resolves stay apart here, even within the
+/// difference limen: they are merged when the recordings are combined, which averages their
+/// frequencies and decays and sums their amplitudes (seed 000 section 5.4.1).
+fn dedupe(modes: &mut Vec<Found>, bin_hz: f64) {
     modes.sort_by(|a, b| a.freq_hz.total_cmp(&b.freq_hz));
     let mut kept: Vec<Found> = Vec::with_capacity(modes.len());
     for m in modes.drain(..) {
         match kept.last_mut() {
-            Some(last) if m.freq_hz - last.freq_hz < difference_limen_hz(m.freq_hz) => {
+            Some(last) if m.freq_hz - last.freq_hz < bin_hz => {
                 if m.amplitude.norm() > last.amplitude.norm() {
                     *last = m;
                 }

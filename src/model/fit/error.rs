@@ -65,6 +65,13 @@ pub enum FitError {
         /// Seconds needed.
         needed_s: f64,
     },
+    /// A recording clipped through much of its sound.
+    Clipped {
+        /// The recording.
+        name: String,
+        /// Fraction of the sound's samples clipped.
+        fraction: f64,
+    },
     /// No mode rose above the noise floor in any recording.
     NoModes {
         /// The noise floor used, in dBFS.
@@ -107,6 +114,13 @@ impl fmt::Display for FitError {
             FitError::Silent { name, detail } => write!(
                 f,
                 "{name}: no strike found: {detail}; check the file holds the recording of a strike"
+            ),
+            FitError::Clipped { name, fraction } => write!(
+                f,
+                "{name}: clipped: {:.0}% of the sound after the strike is at full scale (at most \
+                 {:.0}% can be fitted); record again with more headroom",
+                100.0 * fraction,
+                100.0 * super::warnings::MAX_CLIPPED_FRACTION
             ),
             FitError::TooShort {
                 name,

@@ -125,4 +125,61 @@ mod tests {
             "{found:?}"
         );
     }
+
+    #[test]
+    fn votes_weigh_each_peak_by_its_power() {
+        // A loud mode that dies within a third of a second against a quiet one that rings all
+        // along: counting frames, or weighing by magnitude, elects the quiet one; weighing by
+        // power (the squared magnitude) elects the loud one.
+        let rate = 48_000.0;
+        let tau = std::f64::consts::TAU;
+        let x: Vec<f64> = (0..48_000)
+            .map(|n| {
+                let t = n as f64 / rate;
+                (-40.0 * t).exp() * (tau * 440.7 * t).sin()
+                    + 0.05 * (-0.5 * t).exp() * (tau * 1234.5 * t).sin()
+            })
+            .collect();
+        let spec = Spectrogram::new(&x, rate, 2048, 512, 2);
+        let sum: f64 = hann(2048).iter().sum();
+        let noise = NoiseSpectrum {
+            power: vec![1e-12 * sum * sum; spec.num_bins()],
+        };
+        let frames = 0..spec.power.len();
+        let all = vote(&spec, &noise, frames.clone(), 0..spec.num_bins(), 10);
+        assert_eq!(all.len(), 2, "{all:?}");
+        let bin_of = |c: &Candidate| (c.freq_hz / spec.bin_hz).round() as usize;
+        let (loud, quiet) = (bin_of(&all[0]), bin_of(&all[1]));
+        assert!((all[0].freq_hz - 440.7).abs() < spec.bin_hz, "{all:?}");
+        // The other weightings would rank them the other way round.
+        let count = |b: usize| spec.power.iter().filter(|f| f[b] > noise.power[b]).count();
+        let magnitude = |b: usize| spec.power.iter().map(|f| f[b].sqrt()).sum::<f64>();
+        assert!(
+            count(quiet) > count(loud),
+            "frames {} vs {}",
+            count(quiet),
+            count(loud)
+        );
+        assert!(magnitude(quiet) > magnitude(loud));
+        // Each vote is the power of its bin summed over the frames where it peaks: here every
+        // frame in which the mode stands above the noise.
+        for c in &all {
+            let b = bin_of(c);
+            let power: f64 = spec
+                .power
+                .iter()
+                .map(|f| f[b])
+                .filter(|&p| p > noise.power[b] * 10f64.powf(PEAK_ABOVE_NOISE_DB / 10.0))
+                .sum();
+            assert!(
+                (c.votes / power - 1.0).abs() < 1e-3,
+                "{} Hz: votes {} against summed power {power}",
+                c.freq_hz,
+                c.votes
+            );
+        }
+        let one = vote(&spec, &noise, frames, 0..spec.num_bins(), 1);
+        assert_eq!(one.len(), 1);
+        assert!((one[0].freq_hz - 440.7).abs() < spec.bin_hz, "{one:?}");
+    }
 }

@@ -2,11 +2,11 @@
 //! bank comes to it, and every warning.
 
 use std::fmt;
-use std::io::Write;
 use std::path::Path;
 
 use serde::Serialize;
 
+use crate::model::staged::StagedFile;
 use crate::model::summary::note_name;
 
 /// The report of a fit, printed by the command line and saved as text or JSON.
@@ -164,9 +164,14 @@ impl fmt::Display for FitReport {
 }
 
 /// Writes `report` to `path`: JSON when the name ends in `.json`, else the text the command line
-/// prints. Atomic like saving a bank: a temporary file in the same directory renamed over `path`,
-/// so a failure leaves `path` as it was.
+/// prints. The file is replaced atomically.
 pub fn save_report_file(report: &FitReport, path: &Path) -> std::io::Result<()> {
+    stage_report_file(report, path)?.commit()
+}
+
+/// Writes `report` as [`save_report_file`] does to a temporary file beside `path`, to replace
+/// `path` when committed.
+pub fn stage_report_file(report: &FitReport, path: &Path) -> std::io::Result<StagedFile> {
     let text = if path.extension().is_some_and(|e| e == "json") {
         // Serializing plain numbers and strings cannot fail; an infinite T60 becomes null.
         let mut json = serde_json::to_string_pretty(report).expect("a report serializes");
@@ -175,18 +180,5 @@ pub fn save_report_file(report: &FitReport, path: &Path) -> std::io::Result<()> 
     } else {
         report.to_string()
     };
-    let dir = match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".modal-report-").suffix(".tmp");
-    // A file the user asked for: the usual permissions less the umask, not a private temporary.
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let mut file = builder.tempfile_in(dir)?;
-    file.write_all(text.as_bytes())?;
-    file.as_file().sync_all()?;
-    file.persist(path).map_err(|e| e.error)?;
-    Ok(())
+    StagedFile::write(path, "modal-report", text.as_bytes())
 }

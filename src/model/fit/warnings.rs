@@ -1,7 +1,8 @@
-//! What is wrong with a recording that still allows a fit: clipping and noise.
+//! What is wrong with a recording that still allows a fit (some clipping, noise), and clipping so
+//! heavy that it does not.
 
 use super::onset::Strike;
-use super::Recording;
+use super::{FitError, Recording};
 
 /// A sample at or above this magnitude counts as full scale...
 const CLIP_LEVEL: f32 = 0.999;
@@ -9,6 +10,10 @@ const CLIP_LEVEL: f32 = 0.999;
 /// ... and this many in a row as clipping: a single full-scale peak is a normalised recording,
 /// a flat run is a converter or a gain stage that ran out of range.
 const CLIP_RUN: usize = 3;
+
+/// A recording with more than this fraction of its sound clipped is refused: its strongest modes
+/// are flattened through much of their ring, so their decays cannot be measured.
+pub const MAX_CLIPPED_FRACTION: f64 = 0.1;
 
 /// A strike less than this many dB above the noise gets a warning.
 pub const NOISY_SNR_DB: f64 = 30.0;
@@ -32,6 +37,25 @@ pub fn input_warnings(recording: &Recording, strike: &Strike) -> Vec<String> {
         ));
     }
     warnings
+}
+
+/// An error when more than [`MAX_CLIPPED_FRACTION`] of the sound of `recording` (from the
+/// strike's onset to its end) is clipped; `origin` names the recording in the message.
+pub fn check_clipping(
+    recording: &Recording,
+    strike: &Strike,
+    origin: &str,
+) -> Result<(), FitError> {
+    let end = strike.end.min(recording.samples.len());
+    let sound = &recording.samples[strike.onset.min(end)..end];
+    let fraction = clipped_samples(sound) as f64 / sound.len().max(1) as f64;
+    if fraction > MAX_CLIPPED_FRACTION {
+        return Err(FitError::Clipped {
+            name: origin.to_string(),
+            fraction,
+        });
+    }
+    Ok(())
 }
 
 /// Samples in runs of at least [`CLIP_RUN`] at full scale.

@@ -64,5 +64,6 @@ pub fn read_wav_recording(path: &Path, name: &str) -> Result<Recording, FitError
         samples,
         sample_rate_hz: spec.sample_rate,
         notes,
+        origin,
     })
 }

@@ -1,0 +1,165 @@
+//! Files written in two steps: the whole content to a temporary file beside the destination,
+//! then a rename over it. A command writing several files stages them all before committing
+//! any, so a failure leaves every destination as it was.
+
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+
+use tempfile::NamedTempFile;
+
+/// A file's new content, written and synced to a temporary file in the destination's directory,
+/// waiting to replace the destination. Dropped without [`commit`](Self::commit), it removes the
+/// temporary file and the destination is untouched.
+#[derive(Debug)]
+pub struct StagedFile {
+    /// The temporary file holding the content.
+    temp: NamedTempFile,
+    /// Where the content goes.
+    path: PathBuf,
+}
+
+impl StagedFile {
+    /// Writes `content` to a temporary file named `.{prefix}-*.tmp` beside `path`.
+    pub fn write(path: &Path, prefix: &str, content: &[u8]) -> io::Result<Self> {
+        let dir = match path.parent() {
+            Some(dir) if !dir.as_os_str().is_empty() => dir,
+            _ => Path::new("."),
+        };
+        let mut builder = tempfile::Builder::new();
+        let prefix = format!(".{prefix}-");
+        builder.prefix(&prefix).suffix(".tmp");
+        // A file the user asked for: the usual permissions less the umask, not a private
+        // temporary's owner-only ones.
+        #[cfg(unix)]
+        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+        let mut temp = builder.tempfile_in(dir)?;
+        temp.write_all(content)?;
+        temp.as_file().sync_all()?;
+        Ok(Self {
+            temp,
+            path: path.to_path_buf(),
+        })
+    }
+
+    /// The destination.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Renames the content over the destination, atomically.
+    pub fn commit(self) -> io::Result<()> {
+        self.temp
+            .persist(&self.path)
+            .map(|_| ())
+            .map_err(|e| e.error)
+    }
+}
+
+/// A destination replaced by [`commit_all`], and what it held before.
+struct Replaced {
+    /// The destination.
+    path: PathBuf,
+    /// A copy of the file it held; `None` when it held none.
+    backup: Option<tempfile::TempPath>,
+}
+
+/// Puts every staged file in place, or none: when one cannot be put in place, those put before
+/// it are taken back (the files they replaced restored). On failure, returns the destination
+/// that failed with the error.
+pub fn commit_all(files: Vec<StagedFile>) -> Result<(), (PathBuf, io::Error)> {
+    let mut done: Vec<Replaced> = Vec::with_capacity(files.len());
+    for file in files {
+        let path = file.path.clone();
+        let result = keep_copy(&path).and_then(|backup| file.commit().map(|()| backup));
+        match result {
+            Ok(backup) => done.push(Replaced { path, backup }),
+            Err(error) => {
+                for replaced in done.into_iter().rev() {
+                    let _ = match replaced.backup {
+                        Some(backup) => backup.persist(&replaced.path).map_err(|e| e.error),
+                        None => std::fs::remove_file(&replaced.path),
+                    };
+                }
+                return Err((path, error));
+            }
+        }
+    }
+    // Dropping the copies removes them.
+    Ok(())
+}
+
+/// A copy of the file at `path`, if there is one, under a temporary name beside it, removed when
+/// dropped.
+fn keep_copy(path: &Path) -> io::Result<Option<tempfile::TempPath>> {
+    if !path.is_file() {
+        return Ok(None);
+    }
+    let dir = match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    };
+    let backup = tempfile::Builder::new()
+        .prefix(".modal-previous-")
+        .suffix(".tmp")
+        .tempfile_in(dir)?
+        .into_temp_path();
+    std::fs::copy(path, &backup)?;
+    Ok(Some(backup))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nothing_changes_until_the_commit_and_a_drop_leaves_no_trace() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.txt");
+        std::fs::write(&path, "old").unwrap();
+        let staged = StagedFile::write(&path, "test", b"new").unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "old");
+        drop(staged);
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "old");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        StagedFile::write(&path, "test", b"new")
+            .unwrap()
+            .commit()
+            .unwrap();
+        assert_eq!(std::fs::read_to_string(&path).unwrap(), "new");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+    }
+
+    #[test]
+    fn a_failed_commit_puts_back_every_file_committed_before_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let (kept, new) = (dir.path().join("kept.txt"), dir.path().join("new.txt"));
+        std::fs::write(&kept, "old").unwrap();
+        // A destination that is a directory cannot be replaced by a file.
+        let blocked = dir.path().join("blocked");
+        std::fs::create_dir(&blocked).unwrap();
+        let files = vec![
+            StagedFile::write(&kept, "test", b"new").unwrap(),
+            StagedFile::write(&new, "test", b"new").unwrap(),
+            StagedFile::write(&blocked, "test", b"new").unwrap(),
+        ];
+        let (failed, _) = commit_all(files).unwrap_err();
+        assert_eq!(failed, blocked);
+        assert_eq!(std::fs::read_to_string(&kept).unwrap(), "old");
+        assert!(!new.exists());
+        let mut left: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(left, ["blocked", "kept.txt"]);
+
+        let files = vec![
+            StagedFile::write(&kept, "test", b"new").unwrap(),
+            StagedFile::write(&new, "test", b"new").unwrap(),
+        ];
+        commit_all(files).unwrap();
+        assert_eq!(std::fs::read_to_string(&kept).unwrap(), "new");
+        assert_eq!(std::fs::read_to_string(&new).unwrap(), "new");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 3);
+    }
+}
