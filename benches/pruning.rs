@@ -14,8 +14,8 @@
 //! Run with `cargo bench --bench pruning`. Settings for experiments, from the environment:
 //! `PRUNING_REPEATS` (timed renders per case, default 3, the fastest counts),
 //! `PRUNING_OFFSETS=2.5,5,20` (other masking offsets; the targets are read at 5 dB),
-//! `PRUNING_FRAME_MS` (another analysis frame) and `PRUNING_ONLY=5` (one pruned render with
-//! every counter, for profilers).
+//! `PRUNING_FRAME_MS` (another analysis frame) and `PRUNING_ONLY=5` (pruned renders only,
+//! `PRUNING_REPEATS` of them, with every counter of the last, for profilers).
 
 use std::hint::black_box;
 use std::sync::Arc;
@@ -226,13 +226,16 @@ fn main() {
     );
     println!();
 
-    // `PRUNING_ONLY=5` renders one pruned case and stops, for profilers.
+    // `PRUNING_ONLY=5` renders the pruned case only, for profilers.
     if let Some(av) = std::env::var("PRUNING_ONLY")
         .ok()
         .and_then(|v| v.parse::<f32>().ok())
     {
         let c = controls(&bank, objects.len(), Some(av));
-        let run = render(&prepared, &impacts, seconds, &c, false);
+        let mut run = render(&prepared, &impacts, seconds, &c, false);
+        for _ in 1..repeats() {
+            run = render(&prepared, &impacts, seconds, &c, false);
+        }
         println!(
             "a_v {av} dB: {:.1} ms, analyses {:.1} ms, strikes {:.1} ms, {:.1e} mode-samples, {:?}",
             run.wall_s * 1e3,
