@@ -119,6 +119,8 @@ pub struct MeterReading {
     pub live_modes: u32,
     /// Modes the kernels advance per sample, over all voices.
     pub computed_modes: u32,
+    /// Live modes switched off by pruning or the budget, over all voices.
+    pub pruned_modes: u32,
     /// Modes in the bank playing.
     pub bank_modes: u32,
     /// Largest absolute output sample since the last reading, linear.
@@ -137,6 +139,8 @@ pub struct EditorShared {
     live_modes: AtomicU32,
     /// Computed modes over all voices.
     computed_modes: AtomicU32,
+    /// Live modes switched off by pruning or the budget.
+    pruned_modes: AtomicU32,
     /// Modes in the bank playing.
     bank_modes: AtomicU32,
     /// Largest absolute output sample since the GUI last read it, as f32 bits (non-negative
@@ -147,6 +151,9 @@ pub struct EditorShared {
     /// Summed energy `|z|^2` of each mode over the voices (in the prepared bank's order), as f32
     /// bits; `SILENT_BITS` for a mode sounding nowhere.
     energy: Box<[AtomicU32]>,
+    /// One bit per mode (same order), set for a mode pruning or the budget has switched off in
+    /// some voice: its energy is carried analytically, not computed.
+    pruned: Box<[AtomicU32]>,
     /// How many entries of `energy` the last publication wrote.
     energy_modes: AtomicU32,
     /// The bank generation (see [`BankField`](crate::params::BankField)) the energies belong to.
@@ -178,11 +185,15 @@ impl EditorShared {
             voices: AtomicU32::new(0),
             live_modes: AtomicU32::new(0),
             computed_modes: AtomicU32::new(0),
+            pruned_modes: AtomicU32::new(0),
             bank_modes: AtomicU32::new(0),
             peak_bits: AtomicU32::new(0),
             load_bits: AtomicU32::new(0),
             energy: (0..MAX_METERED_MODES)
                 .map(|_| AtomicU32::new(SILENT_BITS))
+                .collect(),
+            pruned: (0..MAX_METERED_MODES.div_ceil(32))
+                .map(|_| AtomicU32::new(0))
                 .collect(),
             energy_modes: AtomicU32::new(0),
             energy_generation: AtomicU64::new(0),
@@ -242,6 +253,8 @@ impl EditorShared {
             .store(stats.live_modes as u32, Ordering::Relaxed);
         self.computed_modes
             .store(stats.computed_modes as u32, Ordering::Relaxed);
+        self.pruned_modes
+            .store(stats.dormant_modes as u32, Ordering::Relaxed);
         let n = engine.bank().num_modes().min(self.energy.len());
         self.bank_modes
             .store(engine.bank().num_modes() as u32, Ordering::Relaxed);
@@ -258,6 +271,14 @@ impl EditorShared {
                 slot.store(sum.to_bits(), Ordering::Relaxed);
             }
         });
+        for word in &self.pruned[..n.div_ceil(32)] {
+            word.store(0, Ordering::Relaxed);
+        }
+        engine.visit_switched_off_modes(|m| {
+            if m < n {
+                self.pruned[m / 32].fetch_or(1 << (m % 32), Ordering::Relaxed);
+            }
+        });
         self.energy_modes.store(n as u32, Ordering::Relaxed);
         self.energy_generation.store(generation, Ordering::Relaxed);
         self.energy_seq
@@ -271,6 +292,7 @@ impl EditorShared {
             voices: self.voices.load(Ordering::Relaxed),
             live_modes: self.live_modes.load(Ordering::Relaxed),
             computed_modes: self.computed_modes.load(Ordering::Relaxed),
+            pruned_modes: self.pruned_modes.load(Ordering::Relaxed),
             bank_modes: self.bank_modes.load(Ordering::Relaxed),
             peak: f32::from_bits(self.peak_bits.swap(0, Ordering::Relaxed)),
             dsp_load: f32::from_bits(self.load_bits.swap(0, Ordering::Relaxed)),
@@ -278,12 +300,19 @@ impl EditorShared {
     }
 
     /// GUI: the energy of each mode of bank `generation` (prepared order) into `out`, `None` for
-    /// modes sounding nowhere. Returns `false` (and clears `out`) when the energies published
-    /// belong to another bank.
-    pub fn read_energies(&self, generation: u64, out: &mut Vec<Option<f32>>) -> bool {
+    /// modes sounding nowhere, and into `pruned` whether pruning or the budget has switched the
+    /// mode off (its energy then carried analytically). Returns `false` (and clears both) when
+    /// the energies published belong to another bank.
+    pub fn read_energies(
+        &self,
+        generation: u64,
+        out: &mut Vec<Option<f32>>,
+        pruned: &mut Vec<bool>,
+    ) -> bool {
         // A copy torn by a publication under way is read again; a GUI frame never waits long.
         for _ in 0..READ_ATTEMPTS {
             out.clear();
+            pruned.clear();
             let before = self.energy_seq.load(Ordering::Acquire);
             if before % 2 == 1 {
                 std::hint::spin_loop();
@@ -296,16 +325,23 @@ impl EditorShared {
                     let e = f32::from_bits(slot.load(Ordering::Relaxed));
                     (e >= 0.0).then_some(e)
                 }));
+                pruned.extend(
+                    (0..n).map(|m| {
+                        self.pruned[m / 32].load(Ordering::Relaxed) & (1 << (m % 32)) != 0
+                    }),
+                );
             }
             fence(Ordering::Acquire);
             if self.energy_seq.load(Ordering::Relaxed) == before {
                 if !same_bank {
                     out.clear();
+                    pruned.clear();
                 }
                 return same_bank;
             }
         }
         out.clear();
+        pruned.clear();
         false
     }
 

@@ -470,6 +470,50 @@ fn the_mode_view_shows_live_and_truncated_modes_the_audio_thread_published() {
 }
 
 #[test]
+fn the_mode_view_draws_pruned_modes_hollow() {
+    // A long note on a dense plate with pruning on: some modes are masked and switched off.
+    let bank = factory_bank("steel-plate").unwrap();
+    let mut h = Harness::new(Some(&bank));
+    let mut engine = Engine::new(Arc::new(PreparedBank::new(&bank)));
+    engine.prepare(48_000.0, 512);
+    let mut c = Controls::for_bank(&bank);
+    c.pruning = true;
+    engine.set_controls(&c);
+    let (mut l, mut r) = (vec![0.0; 24_000], vec![0.0; 24_000]);
+    engine.process(&[NoteEvent::on(0, 60, 1.0)], None, &mut l, &mut r);
+    let stats = engine.stats();
+    assert!(stats.voices == 1 && stats.dormant_modes > 0, "{stats:?}");
+    let mut switched_off = Vec::new();
+    engine.visit_switched_off_modes(|m| switched_off.push(m));
+
+    h.shared.publish(&engine, h.generation());
+    h.settle();
+    assert_eq!(
+        h.app.meter_reading().pruned_modes as usize,
+        stats.dormant_modes
+    );
+    let (live, _) = h.app.marks_drawn();
+    assert_eq!(
+        live, stats.live_modes,
+        "pruned modes still show their level"
+    );
+    assert_eq!(
+        h.app.pruned_drawn(),
+        switched_off.len(),
+        "one hollow level per mode switched off"
+    );
+
+    // Pruning off: every live level is computed again.
+    c.pruning = false;
+    engine.set_controls(&c);
+    engine.process(&[], None, &mut l[..4_800], &mut r[..4_800]);
+    assert_eq!(engine.stats().dormant_modes, 0);
+    h.shared.publish(&engine, h.generation());
+    h.settle();
+    assert_eq!(h.app.pruned_drawn(), 0);
+}
+
+#[test]
 fn meters_are_published_at_the_meter_interval() {
     let shared = EditorShared::new();
     let bank = factory_bank("rosewood-marimba-bar").unwrap();
@@ -511,10 +555,10 @@ fn meters_are_published_at_the_meter_interval() {
         0.0,
         "the peak is taken by the reading"
     );
-    let mut energies = Vec::new();
-    assert!(shared.read_energies(7, &mut energies));
+    let (mut energies, mut pruned) = (Vec::new(), Vec::new());
+    assert!(shared.read_energies(7, &mut energies, &mut pruned));
     assert_eq!(energies.len(), bank.modes.len());
-    assert!(!shared.read_energies(8, &mut energies));
+    assert!(!shared.read_energies(8, &mut energies, &mut pruned));
 }
 
 #[test]

@@ -8,7 +8,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use modal_resonator::editor::{Audition, EditorShared};
-use modal_resonator::engine::{Engine, NoteEvent, PreparedBank};
+use modal_resonator::engine::{Controls, Engine, NoteEvent, PreparedBank};
 use modal_resonator::model::factory::factory_bank;
 
 struct Counting;
@@ -57,6 +57,10 @@ fn metering_and_auditions_never_allocate_on_the_audio_thread() {
     let bank = factory_bank("steel-plate").unwrap();
     let mut engine = Engine::new(Arc::new(PreparedBank::new(&bank)));
     engine.prepare(48_000.0, 512);
+    // Pruning on, so the meters publish switched-off modes too.
+    let mut c = Controls::for_bank(&bank);
+    c.pruning = true;
+    engine.set_controls(&c);
     let shared = EditorShared::new();
     let block = 128;
     let (mut l, mut r) = (vec![0.0f32; block], vec![0.0f32; block]);
@@ -92,7 +96,8 @@ fn metering_and_auditions_never_allocate_on_the_audio_thread() {
     });
     assert_eq!(allocations, 0, "allocations or frees on the audio thread");
     assert!(shared.serial() > 10, "meters were published");
-    let mut energies = Vec::new();
-    assert!(shared.read_energies(3, &mut energies));
+    let (mut energies, mut pruned) = (Vec::new(), Vec::new());
+    assert!(shared.read_energies(3, &mut energies, &mut pruned));
     assert!(energies.iter().any(Option::is_some), "modes sound");
+    assert_eq!(pruned.len(), energies.len());
 }

@@ -90,6 +90,10 @@ pub struct EditorApp {
     energies: Vec<Option<f32>>,
     /// The same by index in the bank, when it belongs to the bank shown.
     energy_by_mode: Vec<Option<f32>>,
+    /// Whether each mode is switched off by pruning, as published (prepared order).
+    pruned: Vec<bool>,
+    /// The same by index in the bank.
+    pruned_by_mode: Vec<bool>,
     /// Whether `energy_by_mode` belongs to the bank shown.
     energies_valid: bool,
     /// The bank's summary, with the session version it was made for.
@@ -134,6 +138,8 @@ impl EditorApp {
             meters: Meters::default(),
             energies: Vec::new(),
             energy_by_mode: Vec::new(),
+            pruned: Vec::new(),
+            pruned_by_mode: Vec::new(),
             energies_valid: false,
             summary: None,
             last_time_s: None,
@@ -181,6 +187,12 @@ impl EditorApp {
     /// How many live levels and truncation marks the mode view drew in the last frame.
     pub fn marks_drawn(&self) -> (usize, usize) {
         self.view.marks_drawn()
+    }
+
+    /// How many of the live levels drawn in the last frame were of modes switched off by
+    /// pruning (drawn hollow).
+    pub fn pruned_drawn(&self) -> usize {
+        self.view.pruned_drawn()
     }
 
     /// Where the mode view drew mode `i`'s stem head in the last frame.
@@ -363,6 +375,7 @@ impl EditorApp {
         let input = ViewInput {
             weights,
             energy: self.energies_valid.then_some(&self.energy_by_mode[..]),
+            pruned: self.energies_valid.then_some(&self.pruned_by_mode[..]),
             sounding: self.meters.reading().voices > 0,
         };
         self.view

@@ -77,14 +77,21 @@ impl Meters {
             ui.label("Modes");
             let per_voice = r.live_modes as f32 / r.voices.max(1) as f32;
             bar(ui, per_voice / r.bank_modes.max(1) as f32, false);
+            let pruned = if r.pruned_modes > 0 {
+                format!(" · {} pruned", r.pruned_modes)
+            } else {
+                String::new()
+            };
             ui.label(format!(
-                "{} live · {} computed · bank {}",
+                "{} live{pruned} · {} computed · bank {}",
                 r.live_modes, r.computed_modes, r.bank_modes
             ))
             .on_hover_text(
-                "Live: modes sounding over all voices. Computed: modes the resonators advance \
-                 per sample (live modes plus padding to whole SIMD rows). The bar compares one \
-                 voice's live modes with the bank's",
+                "Live: modes sounding over all voices. Pruned: live modes switched off by \
+                 perceptual pruning or the mode budget, their state carried without computing \
+                 them. Computed: modes the resonators advance per sample (live modes not pruned, \
+                 plus padding to whole SIMD rows). The bar compares one voice's live modes with \
+                 the bank's",
             );
             ui.separator();
             ui.label("Output");

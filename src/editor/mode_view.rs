@@ -1,7 +1,8 @@
 //! The mode view: every mode as a stem on a log-frequency axis, its height the mode's gain at the
 //! strike position and its colour its T60, with the live level of sounding modes drawn over it.
 //! Modes not heard (muted) are grey; modes dropped by truncation while the object sounds are
-//! marked. Hovering shows a mode's numbers; clicking selects it; dragging a stem moves its
+//! marked; modes switched off by perceptual pruning or the mode budget show their level hollow
+//! (it is carried analytically, not computed). Hovering shows a mode's numbers; clicking selects it; dragging a stem moves its
 //! frequency (sideways) and gain (up and down), finely with Shift, gain alone with Ctrl.
 
 use egui::emath::GuiRounding;
@@ -30,6 +31,9 @@ pub struct ViewInput<'a> {
     /// Live energy `|z|^2` of each mode by index in the bank (`None`: sounding nowhere), when
     /// the plugin plays this very bank.
     pub energy: Option<&'a [Option<f32>]>,
+    /// Whether each mode (by index in the bank) is switched off by pruning or the budget, with
+    /// `energy`.
+    pub pruned: Option<&'a [bool]>,
     /// Whether any voice sounds now.
     pub sounding: bool,
 }
@@ -68,6 +72,8 @@ pub struct ModeView {
     live_drawn: usize,
     /// Truncation marks drawn in the last frame.
     truncated_drawn: usize,
+    /// Live levels of pruned modes drawn in the last frame.
+    pruned_drawn: usize,
     /// Where each stem's head was drawn in the last frame, by index in the bank.
     heads: Vec<Pos2>,
     /// The plotting area in the last frame.
@@ -83,6 +89,7 @@ impl Default for ModeView {
             stems_drawn: 0,
             live_drawn: 0,
             truncated_drawn: 0,
+            pruned_drawn: 0,
             heads: Vec::new(),
             plot: Rect::NOTHING,
         }
@@ -103,6 +110,11 @@ impl ModeView {
     /// How many live levels and truncation marks the last frame drew.
     pub fn marks_drawn(&self) -> (usize, usize) {
         (self.live_drawn, self.truncated_drawn)
+    }
+
+    /// How many of the live levels the last frame drew were of pruned modes.
+    pub fn pruned_drawn(&self) -> usize {
+        self.pruned_drawn
     }
 
     /// Where the last frame drew mode `i`'s stem head.
@@ -219,6 +231,7 @@ impl ModeView {
         let mut selected = None;
         self.heads.clear();
         (self.stems_drawn, self.live_drawn, self.truncated_drawn) = (0, 0, 0);
+        self.pruned_drawn = 0;
         for (i, mode) in session.bank().modes.iter().enumerate() {
             let x = map.x(mode.freq_hz).round_to_pixel_center(ppp);
             let gain = session.gain_at(i, &input.weights);
@@ -228,7 +241,17 @@ impl ModeView {
             if let Some(Some(energy)) = live {
                 let level_y = map.y(map.axes.top_db + 10.0 * (energy.max(1e-30) as f64).log10());
                 let bar = Rect::from_min_max(pos2(x - 3.0, level_y), pos2(x + 3.0, bottom));
-                painter.rect_filled(bar, CornerRadius::ZERO, style::LIVE.gamma_multiply(0.55));
+                if is_pruned(input, i) {
+                    painter.rect_stroke(
+                        bar,
+                        CornerRadius::ZERO,
+                        Stroke::new(1.0, style::PRUNED),
+                        egui::StrokeKind::Inside,
+                    );
+                    self.pruned_drawn += 1;
+                } else {
+                    painter.rect_filled(bar, CornerRadius::ZERO, style::LIVE.gamma_multiply(0.55));
+                }
                 self.live_drawn += 1;
             }
             let colour = if !session.is_audible(i) {
@@ -286,6 +309,13 @@ fn nearest_stem(session: &BankSession, input: &ViewInput, map: &Mapping, p: Pos2
     best.map(|(i, _, _)| i)
 }
 
+/// Whether mode `i` is switched off by pruning or the budget, as published.
+fn is_pruned(input: &ViewInput, i: usize) -> bool {
+    input
+        .pruned
+        .is_some_and(|p| p.get(i).copied().unwrap_or(false))
+}
+
 /// What hovering over mode `i` tells.
 fn describe(session: &BankSession, input: &ViewInput, i: usize) -> String {
     let mode = &session.bank().modes[i];
@@ -309,6 +339,12 @@ fn describe(session: &BankSession, input: &ViewInput, i: usize) -> String {
         Some(Some(e)) => {
             let db = 10.0 * (e.max(1e-30) as f64).log10();
             text.push_str(&format!("\nLevel now {db:.1} dB"));
+            if is_pruned(input, i) {
+                text.push_str(
+                    "\nPruned: masked or below the threshold of hearing, not computed \
+                     (its level is carried, and it comes back in phase)",
+                );
+            }
         }
         Some(None) if input.sounding && session.is_audible(i) => {
             text.push_str("\nTruncated: below the threshold now")
@@ -319,4 +355,39 @@ fn describe(session: &BankSession, input: &ViewInput, i: usize) -> String {
         text.push_str("\nMuted");
     }
     text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::factory::factory_bank;
+
+    #[test]
+    fn hovering_tells_a_pruned_mode_from_a_computed_and_a_truncated_one() {
+        let bank = factory_bank("steel-plate").unwrap();
+        let session = BankSession::new(bank, "test", 1);
+        let n = session.num_modes();
+        let mut energy = vec![Some(1e-4f32); n];
+        energy[2] = None;
+        let mut pruned = vec![false; n];
+        pruned[1] = true;
+        let input = ViewInput {
+            weights: PositionWeights::single(0),
+            energy: Some(&energy),
+            pruned: Some(&pruned),
+            sounding: true,
+        };
+        let computed = describe(&session, &input, 0);
+        assert!(computed.contains("Level now -40.0 dB"), "{computed}");
+        assert!(!computed.contains("Pruned"), "{computed}");
+        let switched_off = describe(&session, &input, 1);
+        assert!(
+            switched_off.contains("Level now -40.0 dB"),
+            "{switched_off}"
+        );
+        assert!(switched_off.contains("Pruned"), "{switched_off}");
+        let truncated = describe(&session, &input, 2);
+        assert!(truncated.contains("Truncated"), "{truncated}");
+        assert!(!truncated.contains("Pruned"), "{truncated}");
+    }
 }

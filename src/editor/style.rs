@@ -18,6 +18,8 @@ pub const LIVE: Color32 = Color32::from_rgb(70, 230, 220);
 pub const MUTED: Color32 = Color32::from_rgb(85, 85, 92);
 /// Modes dropped by truncation while the object sounds.
 pub const TRUNCATED: Color32 = Color32::from_rgb(230, 90, 80);
+/// Live levels of modes switched off by pruning (drawn hollow).
+pub const PRUNED: Color32 = Color32::from_rgb(170, 140, 255);
 /// The selected mode.
 pub const SELECTED: Color32 = Color32::WHITE;
 /// Strike positions of the bank.

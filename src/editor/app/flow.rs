@@ -65,15 +65,26 @@ impl EditorApp {
         self.meters.update(self.shared.take_reading(), dt_s);
 
         let n = self.session.num_modes();
-        let valid = self
-            .shared
-            .read_energies(self.session.generation(), &mut self.energies);
+        let valid = self.shared.read_energies(
+            self.session.generation(),
+            &mut self.energies,
+            &mut self.pruned,
+        );
         self.energies_valid = valid && self.energies.len() == n;
         self.energy_by_mode.clear();
         self.energy_by_mode.resize(n, None);
+        self.pruned_by_mode.clear();
+        self.pruned_by_mode.resize(n, false);
         if self.energies_valid {
-            for (&i, e) in self.session.order().iter().zip(&self.energies) {
+            for ((&i, e), &p) in self
+                .session
+                .order()
+                .iter()
+                .zip(&self.energies)
+                .zip(&self.pruned)
+            {
                 self.energy_by_mode[i] = *e;
+                self.pruned_by_mode[i] = p;
             }
         }
     }

@@ -167,10 +167,11 @@ pub fn draw_legend(painter: &egui::Painter, rect: Rect) {
     let font = FontId::proportional(10.0);
     let mut x = rect.left() + MARGINS.0;
     let y = rect.top() + 4.0;
-    let items: [(&str, Color32); 5] = [
+    let items: [(&str, Color32); 6] = [
         ("T60 short", style::SHORT_T60),
         ("long", style::LONG_T60),
         ("live level", style::LIVE),
+        ("pruned", style::PRUNED),
         ("muted", style::MUTED),
         ("× truncated", style::TRUNCATED),
     ];
