@@ -325,3 +325,43 @@ fn the_automatic_budget_follows_the_measured_cost() {
         s.live_modes - s.dormant_modes
     );
 }
+
+#[test]
+fn dormant_modes_are_dropped_for_good_below_the_truncation_threshold() {
+    // Eight quiet neighbours, masked by a loud long mode, die fast: switched off first, then
+    // forgotten once their carried level falls under the truncation threshold.
+    let mut modes = vec![(500.0, 1.0, 1.0)];
+    modes.extend((0..8).map(|k| (520.0 + 25.0 * k as f64, 20.0, 0.05)));
+    let bank = simple_bank(&modes);
+    let mut e = pruned_engine(&bank);
+    let mut c = e.controls().clone();
+    c.truncation_db = -60.0;
+    e.set_controls(&c);
+    strike(&mut e, 0.1);
+    assert_eq!(switched_off(&e).len(), 8, "the neighbours are masked");
+    assert_eq!(e.pruning_stats().dropped, 0);
+    run(&mut e, 1.0);
+    let stats = e.stats();
+    assert_eq!(e.pruning_stats().dropped, 8, "{:?}", e.pruning_stats());
+    assert_eq!(stats.dormant_modes, 0);
+    assert_eq!(stats.live_modes, 1, "the masker rings on alone");
+}
+
+#[test]
+fn a_budget_holds_within_a_control_period_of_a_strike() {
+    let bank = dense_bank(300, 60.0);
+    let mut e = pruned_engine(&bank);
+    let mut c = e.controls().clone();
+    c.pruning = false;
+    c.mode_budget = 20;
+    e.set_controls(&c);
+    let key = root(&e);
+    // Two control periods: the strike, then the tick that ranks what it started.
+    render(&mut e, &[on(0, key, 1.0)], 128.0 / RATE as f64, 64);
+    let s = e.stats();
+    assert!(s.live_modes > 200, "{s:?}");
+    assert!(
+        s.live_modes - s.dormant_modes - s.fading_modes <= 20,
+        "more than the budget computed at full level: {s:?}"
+    );
+}

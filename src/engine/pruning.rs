@@ -2,7 +2,7 @@
 //! ([`super::budget`]) applied to what it keeps.
 //!
 //! Every analysis frame (a whole number of control periods, so the output does not depend on how
-//! the host cuts blocks), and at the control tick after a strike, the pruner
+//! the host cuts blocks), and under a budget also at the control tick after a strike, the pruner
 //!
 //! 1. estimates each mode's energy: `|z|^2 / 2` of its phasor, which is seed 001 eq. 3 exactly
 //!    (the sum of potential and kinetic energy), plus a bound on what the strikes under way will
@@ -25,7 +25,9 @@
 //! before its masker's curve has fallen below it (`unmask_delay_samples`). A mode is looked at
 //! again when that time comes, when its voice is struck, or when its masker's voice changes
 //! (retuned, stolen, silenced); the maskers of the other modes carry over from frame to frame.
-//! Every [`FULL_EVERY`] frames, and whenever the settings change, every mode is looked at.
+//! Every [`FULL_EVERY`] frames every computed mode is looked at, and about every
+//! [`DORMANT_FULL_S`] every dormant one too, whatever its recheck time says; whenever the settings
+//! change, everything is.
 
 mod analysis;
 mod candidates;
@@ -54,6 +56,10 @@ const MAX_FADE_S: f64 = 0.25;
 /// Every this many analyses, every mode is looked at, so a strike that masks other voices' modes
 /// switches them off.
 const FULL_EVERY: u32 = 4;
+
+/// At least this often (in seconds of audio), every dormant mode is looked at too: a safety net
+/// under the predicted recheck times (a masker that has since gone dormant itself masks nothing).
+const DORMANT_FULL_S: f64 = 1.0;
 
 /// A masker tag meaning "nothing to watch".
 const NO_TAG: u32 = u32::MAX;
@@ -162,6 +168,8 @@ pub(super) struct Pruner {
     num_rechecks: usize,
     /// Analyses since every mode was last looked at.
     since_full: u32,
+    /// Analyses since every dormant mode was last looked at.
+    since_dormant_full: u32,
     /// Whether modes may be dormant or fading somewhere.
     engaged: bool,
     /// Whether the input has woken modes since the last analysis.
@@ -198,6 +206,7 @@ impl Pruner {
             rechecks: Vec::new(),
             num_rechecks: 0,
             since_full: 0,
+            since_dormant_full: 0,
             engaged: false,
             pending: false,
             settings: None,

@@ -44,3 +44,38 @@ fn set_by_name_reports_range_and_names() {
     c.set_by_name("polyphony", "8").unwrap();
     assert_eq!(c.polyphony, 8);
 }
+
+#[test]
+fn pruning_controls_are_set_by_name_within_their_ranges() {
+    let mut c = Controls::default();
+    assert!(!c.pruning, "pruning is off by default");
+    c.set_by_name("pruning", "on").unwrap();
+    assert!(c.pruning);
+    c.set_by_name("pruning", "0").unwrap();
+    assert!(!c.pruning);
+    assert!(c
+        .set_by_name("pruning", "maybe")
+        .unwrap_err()
+        .contains("expected on or off"));
+    c.set_by_name("masking_offset_db", "2.5").unwrap();
+    assert_eq!(c.masking_offset_db, 2.5);
+    assert!(c
+        .set_by_name("masking_offset_db", "25")
+        .unwrap_err()
+        .contains("0 to 20"));
+    c.set_by_name("playback_level_db_spl", "80").unwrap();
+    assert_eq!(c.playback_level_db_spl, 80.0);
+    assert!(c.set_by_name("playback_level_db_spl", "130").is_err());
+    c.set_by_name("analysis_frame_ms", "46").unwrap();
+    assert_eq!(c.analysis_frame_ms, 46.0);
+    assert!(c.set_by_name("analysis_frame_ms", "1").is_err());
+    c.set_by_name("mode_budget", "400").unwrap();
+    assert_eq!(c.mode_budget, 400);
+    assert!(c
+        .set_by_name("mode_budget", "12.5")
+        .unwrap_err()
+        .contains("whole number"));
+    c.set_by_name("target_load_pct", "50").unwrap();
+    assert_eq!(c.target_load_pct, 50.0);
+    assert!(c.set_by_name("target_load_pct", "150").is_err());
+}

@@ -3,9 +3,9 @@
 
 use std::time::Instant;
 
-use super::candidates::{Reading, DORMANT, DROP, LOCKED, OVER_BUDGET};
+use super::candidates::{Reading, DORMANT, DRIVEN, DROP, LOCKED, OVER_BUDGET, UNSURE_MASKER};
 use super::{fade_samples, frame_samples, samples_to_cross, VoiceWatch};
-use super::{FULL_EVERY, GENERATION_MASK, NO_TAG};
+use super::{DORMANT_FULL_S, FULL_EVERY, GENERATION_MASK, NO_TAG};
 use crate::dsp::coeffs::gain_to_db;
 use crate::dsp::pruning::{keep_most_energetic, Verdict, PRIOR};
 use crate::engine::voice::VoiceState;
@@ -75,6 +75,14 @@ impl Engine {
         // A budget ranks everything heard, so it looks at everything.
         let full = recheck_all || any_changed || cap.is_some() || p.since_full + 1 >= FULL_EVERY;
         p.since_full = if full { 0 } else { p.since_full + 1 };
+        let frame = frame_samples(c.analysis_frame_ms, rate) as f64;
+        let dormant_every = (DORMANT_FULL_S * rate / frame).ceil() as u32;
+        let dormant_full = recheck_all || p.since_dormant_full + 1 >= dormant_every;
+        p.since_dormant_full = if dormant_full {
+            0
+        } else {
+            p.since_dormant_full + 1
+        };
         p.stats.full_analyses += full as u64;
 
         // Steps 1-4 of seed 001's pseudo-code: the energies of the modes that may change state.
@@ -109,7 +117,7 @@ impl Engine {
                 } else {
                     m.power
                 };
-                let flags = if locked { LOCKED } else { 0 };
+                let flags = if locked { LOCKED } else { 0 } | if driven { DRIVEN } else { 0 };
                 cands.push(
                     vi,
                     generation,
@@ -122,7 +130,7 @@ impl Engine {
                 );
             });
             let bank_now = v.modes.clock();
-            let due = if recheck_all || any_changed {
+            let due = if dormant_full || any_changed {
                 u64::MAX
             } else {
                 bank_now
@@ -135,7 +143,7 @@ impl Engine {
                         .get(masker)
                         .is_none_or(|&g| g != d.tag & GENERATION_MASK)
                 };
-                if !(recheck_all || stale_tag || d.recheck_at <= bank_now) {
+                if !(dormant_full || stale_tag || d.recheck_at <= bank_now) {
                     return;
                 }
                 // A driven voice cannot fade modes in: its dormant ones wait.
@@ -256,7 +264,8 @@ impl Engine {
                 m.len += 1;
             }
             for &j in p.pass.maskers() {
-                if j & PRIOR == 0 {
+                // Maskers silenced by the budget or lifted by a strike's bound are not carried.
+                if j & PRIOR == 0 && cd.flags[j as usize] & UNSURE_MASKER == 0 {
                     let i = j as usize;
                     let voice = (cd.who[i] >> 24) as usize;
                     m.push(

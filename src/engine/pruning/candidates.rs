@@ -14,6 +14,11 @@ pub(super) const DORMANT: u8 = 2;
 pub(super) const DROP: u8 = 4;
 /// Candidate flag: audible but beyond the budget.
 pub(super) const OVER_BUDGET: u8 = 8;
+/// Candidate flag: its level includes a bound on what a strike under way adds, so as a masker
+/// it may be louder than it will be.
+pub(super) const DRIVEN: u8 = 16;
+/// Flags of a masker not to be relied on past this analysis (its curve may be too high).
+pub(super) const UNSURE_MASKER: u8 = OVER_BUDGET | DRIVEN;
 
 /// The mode in a `voice << 24 | mode` pair.
 pub(super) const MODE_MASK: u32 = 0x00ff_ffff;

@@ -1,7 +1,7 @@
 //! Why a mode is off, and when it could be heard again: the masker's curve over it, falling as
 //! the masker decays (`unmask_delay_samples`), or the threshold in quiet, until truncation.
 
-use super::candidates::{MODE_MASK, OVER_BUDGET};
+use super::candidates::{MODE_MASK, OVER_BUDGET, UNSURE_MASKER};
 use super::{samples_to_cross, Pruner, NO_TAG};
 use crate::dsp::masking::{curve_spread, unmask_delay_samples};
 use crate::dsp::pruning::{Verdict, PRIOR};
@@ -52,6 +52,10 @@ impl Pruner {
                     cd.fall_db[i],
                 );
                 let delay = (delay.clamp(0.0, 1e15) as u64).min(to_truncation);
+                // A masker silenced by the budget, or whose level holds a strike's bound, may
+                // not mask as long as its curve says: look again at the next analysis.
+                let unsure = by & PRIOR == 0 && cd.flags[by as usize] & UNSURE_MASKER != 0;
+                let delay = if unsure { 0 } else { delay };
                 let reason = OffReason {
                     // The envelope of every masker's curve: the masker named is one under it.
                     curve_db: cd.envelope_db[i],

@@ -12,7 +12,7 @@
 
 use std::time::Instant;
 
-use super::candidates::{Reading, DORMANT};
+use super::candidates::{Reading, DORMANT, DRIVEN};
 use super::{samples_to_cross, OffReason, NO_TAG};
 use crate::dsp::masking::{power_to_db, DB_PER_NEPER};
 use crate::dsp::resonator_bank::{Pulse, PulseShape};
@@ -25,6 +25,15 @@ impl Engine {
     /// dormant modes are to take analytically with [`Engine::settle_strike`], if any remain.
     pub(in crate::engine) fn prepare_strike(&mut self, i: usize, kind: ExciterKind) -> bool {
         self.pruner.struck[i] = true;
+        // Under a budget, the modes the strike starts are ranked at the next control tick rather
+        // than a frame later, so the cap holds within a control period.
+        if self
+            .budget
+            .cap(&self.controls, self.sample_rate_hz)
+            .is_some()
+        {
+            self.pruner.pending = true;
+        }
         let modes = &mut self.voices[i].modes;
         if modes.num_dormant() + modes.num_fading() == 0 {
             return false;
@@ -170,7 +179,7 @@ impl Engine {
                 power_to_db(a * a),
                 m.theta,
                 m.delta,
-                0,
+                DRIVEN,
                 &reading,
             );
         });
