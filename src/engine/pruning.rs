@@ -277,6 +277,25 @@ impl Pruner {
     }
 }
 
+impl Pruner {
+    /// The masking pass over the candidates in hand, after the first `num_prior` prior maskers:
+    /// verdicts and envelopes into the candidates.
+    fn run_pass(&mut self, num_prior: usize, offset_db: f32) {
+        let n = self.cands.len;
+        let cd = &mut self.cands;
+        self.pass.run_after(
+            &self.prior_bark[..num_prior],
+            &self.prior_level_db[..num_prior],
+            &cd.level_db[..n],
+            &cd.bark[..n],
+            &cd.threshold_db[..n],
+            offset_db,
+            &mut cd.verdicts[..n],
+            Some(&mut cd.envelope_db[..n]),
+        );
+    }
+}
+
 /// Samples per analysis frame: `frame_ms` rounded to whole control periods, at least one.
 fn frame_samples(frame_ms: f32, sample_rate_hz: f64) -> u64 {
     let periods = (frame_ms as f64 * 1e-3 * sample_rate_hz / CONTROL_PERIOD as f64).round();

@@ -167,22 +167,14 @@ impl Engine {
         let num_prior = if full { 0 } else { p.gather_priors(now, None) };
 
         // Steps 5-7: sort, threshold of hearing, masking.
-        let cd = &mut p.cands;
         if c.pruning {
-            p.pass.run_after(
-                &p.prior_bark[..num_prior],
-                &p.prior_level_db[..num_prior],
-                &cd.level_db[..n],
-                &cd.bark[..n],
-                &cd.threshold_db[..n],
-                c.masking_offset_db,
-                &mut cd.verdicts[..n],
-                Some(&mut cd.envelope_db[..n]),
-            );
+            p.run_pass(num_prior, c.masking_offset_db);
         } else {
+            let cd = &mut p.cands;
             cd.verdicts[..n].fill(Verdict::Audible { masker: false });
             cd.envelope_db[..n].fill(f32::NEG_INFINITY);
         }
+        let cd = &mut p.cands;
 
         // The budget: keep the most energetic of what is audible.
         if let Some(cap) = cap {

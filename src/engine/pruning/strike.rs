@@ -186,17 +186,7 @@ impl Engine {
         let n = cands.len;
         p.stats.candidates += n as u64;
         let num_prior = p.gather_priors(now, Some(i));
-        let cd = &mut p.cands;
-        p.pass.run_after(
-            &p.prior_bark[..num_prior],
-            &p.prior_level_db[..num_prior],
-            &cd.level_db[..n],
-            &cd.bark[..n],
-            &cd.threshold_db[..n],
-            c.masking_offset_db,
-            &mut cd.verdicts[..n],
-            Some(&mut cd.envelope_db[..n]),
-        );
+        p.run_pass(num_prior, c.masking_offset_db);
         for k in 0..num_dormant {
             let mode = p.cands.voice_mode(k).1;
             if p.cands.verdicts[k].is_audible() {
