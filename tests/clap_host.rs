@@ -931,3 +931,51 @@ fn a_broken_bank_loaded_while_playing_keeps_the_bank_and_the_state_holds_it() {
         "no state format: {saved}"
     );
 }
+
+#[test]
+fn the_pruning_parameters_reach_the_engine() {
+    // Quiet playback (40 dB SPL at full scale): with pruning on, the bank's quieter modes fall
+    // under the threshold of hearing and are switched off; with it off, the level changes nothing.
+    let note = |prune: f64, spl: f64| {
+        session(
+            INSTRUMENT,
+            None,
+            &[
+                (0, Send::Param("prune", prune)),
+                (0, Send::Param("spl", spl)),
+                (0, Send::On(60, 1.0)),
+            ],
+            None,
+            24_000,
+        )
+    };
+    let largest_difference = |a: &[f32], b: &[f32]| {
+        a.iter()
+            .zip(b)
+            .fold(0.0f32, |m, (x, y)| m.max((x - y).abs()))
+    };
+    let full = note(0.0, 0.0);
+    let plain = session(INSTRUMENT, None, &[(0, Send::On(60, 1.0))], None, 24_000);
+    assert_eq!(
+        full.left, plain.left,
+        "the playback level acts without pruning"
+    );
+    let pruned = note(1.0, 0.0);
+    let scale = peak(&full.left);
+    let diff = largest_difference(&full.left, &pruned.left);
+    assert!(
+        diff > 1e-3 * scale,
+        "pruning at 40 dB SPL changed nothing (largest difference {diff}, peak {scale})"
+    );
+    assert!(
+        peak(&pruned.left[19_200..]) > 1e-3 * scale,
+        "the pruned note fell silent"
+    );
+    // Loud playback (120 dB SPL) brings quiet modes above the threshold of hearing again.
+    let loud = note(1.0, 1.0);
+    let diff = largest_difference(&loud.left, &pruned.left);
+    assert!(
+        diff > 1e-3 * scale,
+        "the playback level changed nothing (largest difference {diff}, peak {scale})"
+    );
+}
