@@ -132,6 +132,30 @@ fn masked_cluster(loud_decay_per_s: f64) -> Bank {
     simple_bank(&modes)
 }
 
+/// Two engines for `bank`: [`pruned_engine`], and the same with pruning off.
+fn pruned_and_full(bank: &Bank) -> (Engine, Engine) {
+    let mut full = pruned_engine(bank);
+    let mut c = full.controls().clone();
+    c.pruning = false;
+    full.set_controls(&c);
+    (pruned_engine(bank), full)
+}
+
+/// Renders 0.1 s more on both and checks they agree sample by sample within `tolerance` of the
+/// full render's peak (which must not be silence).
+fn assert_next_samples_agree(pruned: &mut Engine, full: &mut Engine, tolerance: f32) {
+    let p = run(pruned, 0.1);
+    let u = run(full, 0.1);
+    let scale = peak(&u);
+    assert!(scale > 1e-4, "the full render is silent");
+    for (n, (a, b)) in p.iter().zip(&u).enumerate() {
+        assert!(
+            (a - b).abs() < tolerance * scale,
+            "sample {n}: pruned {a}, full {b} (peak {scale})"
+        );
+    }
+}
+
 /// Largest second difference of `x`: a step shows as a spike, a sine of amplitude `a` at
 /// `theta` radians per sample keeps it under `a theta^2`.
 fn max_second_difference(x: &[f32]) -> f32 {
@@ -142,11 +166,7 @@ fn max_second_difference(x: &[f32]) -> f32 {
 #[test]
 fn switching_modes_off_and_back_on_does_not_click() {
     let bank = masked_cluster(1.0);
-    let mut pruned = pruned_engine(&bank);
-    let mut full = pruned_engine(&bank);
-    let mut c = full.controls().clone();
-    c.pruning = false;
-    full.set_controls(&c);
+    let (mut pruned, mut full) = pruned_and_full(&bank);
     // Pruning switches the neighbours off within the first analysis frames...
     let mut p = strike(&mut pruned, 0.3);
     let mut u = strike(&mut full, 0.3);
@@ -184,11 +204,7 @@ fn modes_brought_back_sound_in_phase_with_the_full_render() {
     // The neighbours outlast their masker, so pruning wakes them once it has faded; and a
     // settings change wakes the rest. Afterwards the pruned render is the full one.
     let bank = masked_cluster(1.0);
-    let mut pruned = pruned_engine(&bank);
-    let mut full = pruned_engine(&bank);
-    let mut c = full.controls().clone();
-    c.pruning = false;
-    full.set_controls(&c);
+    let (mut pruned, mut full) = pruned_and_full(&bank);
     strike(&mut pruned, 0.3);
     strike(&mut full, 0.3);
     assert_eq!(switched_off(&pruned).len(), 8);
@@ -198,15 +214,7 @@ fn modes_brought_back_sound_in_phase_with_the_full_render() {
     // Fades last at most a quarter of a second.
     run(&mut pruned, 0.3);
     run(&mut full, 0.3);
-    let p = run(&mut pruned, 0.1);
-    let u = run(&mut full, 0.1);
-    let scale = peak(&u);
-    for (n, (a, b)) in p.iter().zip(&u).enumerate() {
-        assert!(
-            (a - b).abs() < 1e-4 * scale,
-            "sample {n}: pruned {a}, full {b} (peak {scale})"
-        );
-    }
+    assert_next_samples_agree(&mut pruned, &mut full, 1e-4);
 }
 
 #[test]
@@ -214,11 +222,7 @@ fn a_masked_mode_returns_in_phase_when_its_masker_fades() {
     // The masker falls by 87 dB a second (decay 10/s) and stops masking within a few tenths
     // of a second; the neighbours ring for seconds.
     let bank = masked_cluster(10.0);
-    let mut pruned = pruned_engine(&bank);
-    let mut full = pruned_engine(&bank);
-    let mut c = full.controls().clone();
-    c.pruning = false;
-    full.set_controls(&c);
+    let (mut pruned, mut full) = pruned_and_full(&bank);
     strike(&mut pruned, 0.1);
     strike(&mut full, 0.1);
     let masked = switched_off(&pruned).len();
@@ -232,16 +236,7 @@ fn a_masked_mode_returns_in_phase_when_its_masker_fades() {
         off.iter().all(|&m| m == masker),
         "neighbours still off after the masker faded: {off:?}"
     );
-    let p = run(&mut pruned, 0.1);
-    let u = run(&mut full, 0.1);
-    let scale = peak(&u);
-    assert!(scale > 1e-4);
-    for (n, (a, b)) in p.iter().zip(&u).enumerate() {
-        assert!(
-            (a - b).abs() < 1e-3 * scale,
-            "sample {n}: pruned {a}, full {b} (peak {scale})"
-        );
-    }
+    assert_next_samples_agree(&mut pruned, &mut full, 1e-3);
 }
 
 /// Seed 000 eq. 5.15 for a mode of the engine's bank struck with its gain as amplitude.
