@@ -53,15 +53,20 @@ fn allocations_in(f: impl FnOnce()) -> usize {
     COUNT.with(|c| c.get())
 }
 
+/// A block of `len` samples of a rough, noise-like input in -0.5..0.5.
+fn rough_input(len: usize) -> Vec<f32> {
+    (0..len)
+        .map(|i| ((i * 7919) % 101) as f32 / 101.0 - 0.5)
+        .collect()
+}
+
 #[test]
 fn process_never_allocates() {
     let bank = dense_bank(700, 55.0);
     let mut e = engine(&bank, 48_000.0);
     let block = 256;
     let (mut l, mut r) = (vec![0.0f32; block], vec![0.0f32; block]);
-    let input: Vec<f32> = (0..block)
-        .map(|i| ((i * 7919) % 101) as f32 / 101.0 - 0.5)
-        .collect();
+    let input = rough_input(block);
     // Controls for every block, built before watching.
     let sweeps: Vec<Controls> = (0..200)
         .map(|b| {
@@ -155,9 +160,7 @@ fn pruning_and_the_budget_never_allocate() {
     let mut e = engine(&bank, 48_000.0);
     let block = 256;
     let (mut l, mut r) = (vec![0.0f32; block], vec![0.0f32; block]);
-    let input: Vec<f32> = (0..block)
-        .map(|i| ((i * 7919) % 101) as f32 / 101.0 - 0.5)
-        .collect();
+    let input = rough_input(block);
     // Pruning on throughout, its settings moving; budgets fixed and automatic coming and going.
     let settings: Vec<Controls> = (0..300)
         .map(|b| {

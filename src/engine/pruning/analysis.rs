@@ -29,14 +29,14 @@ impl Engine {
             return;
         }
         let start = self.pruner.profiling.then(Instant::now);
-        self.analyse(input_heard, cap);
+        self.analyse(input_heard, cap, frame);
         if let Some(start) = start {
             self.pruner.stats.analysis_ns += start.elapsed().as_nanos() as u64;
         }
     }
 
-    /// One analysis over every voice.
-    fn analyse(&mut self, input_heard: bool, cap: Option<usize>) {
+    /// One analysis over every voice, analyses being `frame` samples apart.
+    fn analyse(&mut self, input_heard: bool, cap: Option<usize>, frame: u64) {
         let calibration_db = self.calibration_db();
         let Engine {
             pruner: p,
@@ -75,8 +75,7 @@ impl Engine {
         // A budget ranks everything heard, so it looks at everything.
         let full = recheck_all || any_changed || cap.is_some() || p.since_full + 1 >= FULL_EVERY;
         p.since_full = if full { 0 } else { p.since_full + 1 };
-        let frame = frame_samples(c.analysis_frame_ms, rate) as f64;
-        let dormant_every = (DORMANT_FULL_S * rate / frame).ceil() as u32;
+        let dormant_every = (DORMANT_FULL_S * rate / frame as f64).ceil() as u32;
         let dormant_full = recheck_all || p.since_dormant_full + 1 >= dormant_every;
         p.since_dormant_full = if dormant_full {
             0
