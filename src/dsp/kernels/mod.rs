@@ -11,7 +11,9 @@
 //!   latency is hidden, state in registers for the whole run;
 //! - [`Kernel::Avx512`]: AVX-512, four 16-lane vectors (64 modes) in flight.
 //!
-//! All take `rows` as a multiple of [`ROW_BLOCK`], so every kernel sees whole groups.
+//! All take `rows` as a multiple of [`ROW_BLOCK`] (two rows, one AVX-512 vector); rows after the
+//! last whole group go as a smaller group, so a bank with few modes sounding computes little
+//! padding.
 
 mod portable;
 mod scalar;
@@ -21,8 +23,8 @@ mod x86;
 /// Modes per row: one accumulator lane (and one stereo position) per column.
 pub const COLUMNS: usize = 8;
 
-/// Row counts handed to kernels are multiples of this, so the widest kernel has whole groups.
-pub const ROW_BLOCK: usize = 8;
+/// Row counts handed to kernels are multiples of this: whole vectors for the widest kernel.
+pub const ROW_BLOCK: usize = 2;
 
 /// An implementation of the resonator recursion.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
