@@ -298,16 +298,14 @@ impl ResonatorBank {
         let threshold_sq = threshold * threshold;
         // Usually nothing is due: one pass the compiler vectorises finds out.
         let n = self.rows_active * COLUMNS;
+        let (re, im) = (&self.re[..n], &self.im[..n]);
+        let (entry, fade) = (&self.mode_of_slot[..n], &self.fade_delta[..n]);
         let mut suspects = 0u32;
-        for (((re, im), entry), fade) in self.re[..n]
-            .iter()
-            .zip(&self.im[..n])
-            .zip(&self.mode_of_slot[..n])
-            .zip(&self.fade_delta[..n])
-        {
-            let e = re * re + im * im;
-            // A state that is not a number is retired too.
-            suspects += (*entry != NONE && *fade == 0.0 && below(e, threshold_sq)) as u32;
+        for i in 0..n {
+            let e = re[i] * re[i] + im[i] * im[i];
+            // Branch-free, so the pass vectorises; a state that is not a number is retired too.
+            suspects +=
+                below(e, threshold_sq) as u32 & (entry[i] != NONE) as u32 & (fade[i] == 0.0) as u32;
         }
         if suspects == 0 {
             return 0;

@@ -483,11 +483,23 @@ impl Engine {
         let s = &mut self.smoothed;
         let target_gain = db_to_gain(self.controls.output_gain_db);
         let gain_k = (1.0 - (-1.0 / (GAIN_SMOOTHING_S * self.sample_rate_hz)).exp()) as f32;
-        for ((a, l), r) in self.acc[..n]
-            .iter()
-            .zip(out_l.iter_mut())
-            .zip(out_r.iter_mut())
-        {
+        // Pairwise sums: independent adds, not a chain of eight (one per column).
+        const _: () = assert!(COLUMNS == 8);
+        let mix = |a: &[f32; COLUMNS], w: &[f32; COLUMNS]| {
+            let p: [f32; COLUMNS] = std::array::from_fn(|j| a[j] * w[j]);
+            ((p[0] + p[1]) + (p[2] + p[3])) + ((p[4] + p[5]) + (p[6] + p[7]))
+        };
+        let acc = &self.acc[..n];
+        if s.weight_ramp_left == 0 && s.gain + (target_gain - s.gain) * gain_k == s.gain {
+            // Weights and gain settled: the same sums without the per-sample smoothing.
+            let (weights, gain) = (s.weights, s.gain);
+            for ((a, l), r) in acc.iter().zip(out_l.iter_mut()).zip(out_r.iter_mut()) {
+                *l = mix(a, &weights.0) * gain;
+                *r = mix(a, &weights.1) * gain;
+            }
+            return;
+        }
+        for ((a, l), r) in acc.iter().zip(out_l.iter_mut()).zip(out_r.iter_mut()) {
             if s.weight_ramp_left > 0 {
                 s.weight_ramp_left -= 1;
                 for j in 0..COLUMNS {
@@ -499,13 +511,7 @@ impl Engine {
                 }
             }
             s.gain += (target_gain - s.gain) * gain_k;
-            // Pairwise sums: independent adds, not a chain of eight (one per column).
-            const _: () = assert!(COLUMNS == 8);
-            let mix = |w: &[f32; COLUMNS]| {
-                let p: [f32; COLUMNS] = std::array::from_fn(|j| a[j] * w[j]);
-                ((p[0] + p[1]) + (p[2] + p[3])) + ((p[4] + p[5]) + (p[6] + p[7]))
-            };
-            let (sl, sr) = (mix(&s.weights.0), mix(&s.weights.1));
+            let (sl, sr) = (mix(a, &s.weights.0), mix(a, &s.weights.1));
             *l = sl * s.gain;
             *r = sr * s.gain;
         }
