@@ -90,7 +90,8 @@ unsafe fn avx2_group<const V: usize>(
 ) {
     const W: usize = 8;
     let accp = acc.as_mut_ptr() as *mut f32;
-    // SAFETY: the caller keeps start..start + 8 V within the slices; `acc` has `len` rows of 8.
+    // SAFETY: the caller keeps start..start + 8 V within the slices; each of the `acc.len()`
+    // accumulator rows holds 8 lanes; `process` checked the input has `acc.len()` samples.
     unsafe {
         let zero = _mm256_setzero_ps();
         let (mut r, mut i, mut qr, mut qi, mut g) =
@@ -197,7 +198,8 @@ unsafe fn avx512_group<const V: usize>(
 ) {
     const W: usize = 16;
     let accp = acc.as_mut_ptr() as *mut f32;
-    // SAFETY: the caller keeps start..start + 16 V within the slices; `acc` has `len` rows of 8.
+    // SAFETY: the caller keeps start..start + 16 V within the slices; each of the `acc.len()`
+    // accumulator rows holds 8 lanes; `process` checked the input has `acc.len()` samples.
     unsafe {
         let zero = _mm512_setzero_ps();
         let (mut r, mut i, mut qr, mut qi, mut g) =
