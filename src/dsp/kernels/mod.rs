@@ -6,7 +6,7 @@
 //! they advance at once:
 //!
 //! - [`Kernel::Scalar`]: one mode at a time, the test oracle;
-//! - [`Kernel::Portable`]: four rows of plain arrays the compiler vectorises for any x86-64;
+//! - [`Kernel::Portable`]: two rows of plain arrays the compiler vectorises for any x86-64;
 //! - [`Kernel::Avx2`]: AVX2 + FMA, four 8-lane vectors (32 modes) in flight so the 4-cycle FMA
 //!   latency is hidden, state in registers for the whole run;
 //! - [`Kernel::Avx512`]: AVX-512, four 16-lane vectors (64 modes) in flight.
