@@ -272,15 +272,21 @@ impl MaskingPass {
         envelope(mb, peak, su, bark)
     }
 
-    /// The first masker (loudest first) whose curve at `bark` reaches `level_db`.
+    /// The first masker (loudest first) whose curve at `bark` lies above `level_db`, eight lanes
+    /// at a time, with AVX2 when the CPU has it.
     fn masker_above(&self, bark: f32, level_db: f32) -> usize {
-        (0..self.num_maskers)
-            .find(|&j| {
-                let below = LOWER_SLOPE_DB_PER_BARK * (self.masker_bark[j] - bark);
-                let above = self.masker_upper_slope[j] * (bark - self.masker_bark[j]);
-                self.masker_peak[j] - below.max(above) > level_db
-            })
-            .unwrap_or(0)
+        let used = self.num_maskers.div_ceil(LANES) * LANES;
+        let (mb, peak, su) = (
+            &self.masker_bark[..used],
+            &self.masker_peak[..used],
+            &self.masker_upper_slope[..used],
+        );
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is only set when the CPU supports AVX2 and FMA.
+            return unsafe { first_above_avx2(mb, peak, su, bark, level_db) }.unwrap_or(0);
+        }
+        first_above(mb, peak, su, bark, level_db).unwrap_or(0)
     }
 
     fn push_masker(&mut self, index: usize, bark: f32, level_db: f32, offset_db: f32) {
@@ -321,6 +327,52 @@ fn envelope(masker_bark: &[f32], peak: &[f32], upper_slope: &[f32], bark: f32) -
 #[target_feature(enable = "avx2,fma")]
 unsafe fn envelope_avx2(masker_bark: &[f32], peak: &[f32], upper_slope: &[f32], bark: f32) -> f32 {
     envelope(masker_bark, peak, upper_slope, bark)
+}
+
+/// The first masker, given as parallel lanes as for [`envelope`], whose curve at `bark` lies above
+/// `level_db` (the padding, at a peak of minus infinity, never does).
+#[inline(always)]
+fn first_above(
+    masker_bark: &[f32],
+    peak: &[f32],
+    upper_slope: &[f32],
+    bark: f32,
+    level_db: f32,
+) -> Option<usize> {
+    for (k, ((mb, pk), su)) in masker_bark
+        .chunks_exact(LANES)
+        .zip(peak.chunks_exact(LANES))
+        .zip(upper_slope.chunks_exact(LANES))
+        .enumerate()
+    {
+        let mut above_level = 0u32;
+        for l in 0..LANES {
+            let below = LOWER_SLOPE_DB_PER_BARK * (mb[l] - bark);
+            let above = su[l] * (bark - mb[l]);
+            let curve = pk[l] - if below > above { below } else { above };
+            above_level |= ((curve > level_db) as u32) << l;
+        }
+        if above_level != 0 {
+            return Some(k * LANES + above_level.trailing_zeros() as usize);
+        }
+    }
+    None
+}
+
+/// [`first_above`] compiled for AVX2 and FMA.
+///
+/// # Safety
+/// The CPU must support AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn first_above_avx2(
+    masker_bark: &[f32],
+    peak: &[f32],
+    upper_slope: &[f32],
+    bark: f32,
+    level_db: f32,
+) -> Option<usize> {
+    first_above(masker_bark, peak, upper_slope, bark, level_db)
 }
 
 /// Reorders `ranked` so that its first `keep` entries are those with the most energy (the first

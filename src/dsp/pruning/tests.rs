@@ -151,3 +151,38 @@ fn the_budget_keeps_the_most_energetic() {
     top.sort_by(f32::total_cmp);
     assert_eq!(top, (90..100).map(|e| e as f32).collect::<Vec<_>>());
 }
+
+#[test]
+fn a_masked_mode_names_the_loudest_masker_whose_curve_covers_it() {
+    // Twenty maskers, 2 Bark apart from 1 Bark, falling 1 dB each from 80 dB: more than two
+    // lanes' worth. Probes at 30 dB, far below every curve within reach and beside one masker
+    // each: the masker named is the loudest whose curve lies above the probe, which the
+    // pairwise check finds too, whatever lane it sits in.
+    let n_maskers = 20;
+    let mut level: Vec<f32> = (0..n_maskers).map(|j| 80.0 - j as f32).collect();
+    let mut bark: Vec<f32> = (0..n_maskers).map(|j| 1.0 + 2.0 * j as f32).collect();
+    let probes = [0usize, 7, 8, 9, 15, 19];
+    for &j in &probes {
+        level.push(30.0);
+        bark.push(bark[j] + 0.3);
+    }
+    let n = level.len();
+    let threshold = vec![0.0; n];
+    let mut pass = MaskingPass::with_capacity(n);
+    let mut v = vec![Verdict::Inaudible; n];
+    let av = 5.0;
+    pass.run(&level, &bark, &threshold, av, &mut v);
+    for (p, &j) in probes.iter().enumerate() {
+        let i = n_maskers + p;
+        let expected = (0..n_maskers)
+            .find(|&k| masking_curve_db(bark[k], level[k], av, bark[i]) > level[i])
+            .unwrap();
+        assert_eq!(
+            v[i],
+            Verdict::Masked {
+                by: expected as u32
+            },
+            "probe beside {j}"
+        );
+    }
+}
