@@ -317,6 +317,8 @@ pub struct Engine {
     input_dormant: bool,
     /// Decay rate of each mode with the smoothed damping tilt applied, before Q and pitch.
     tilted_decay: Vec<f64>,
+    /// Every mode's gain at the strike point of the strike in hand.
+    strike_gains: Vec<f32>,
     /// Damped decay rate of each mode at the smoothed material, before pitch scaling.
     decay: Vec<f64>,
     /// How far `decay` lags the smoothed material.
@@ -374,6 +376,7 @@ impl Engine {
             input_heard: false,
             input_dormant: true,
             tilted_decay: Vec::new(),
+            strike_gains: Vec::new(),
             decay: Vec::new(),
             decay_stale: Stale::Tilt,
             damping_version: 0,
@@ -431,6 +434,7 @@ impl Engine {
         }
         self.decay.resize(self.bank.num_modes(), 0.0);
         self.tilted_decay.resize(self.bank.num_modes(), 0.0);
+        self.strike_gains.resize(self.bank.num_modes(), 0.0);
         self.input_dormant = true;
         self.decay_stale = Stale::Tilt;
         self.rebuild_decay_table();
@@ -445,6 +449,7 @@ impl Engine {
         self.pruner.reserve(self.voices.len() + 1, n);
         self.decay = vec![0.0; n];
         self.tilted_decay = vec![0.0; n];
+        self.strike_gains = vec![0.0; n];
     }
 
     /// Silences every voice and restarts smoothing and random sequences. Does not allocate.

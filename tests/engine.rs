@@ -923,3 +923,33 @@ fn input_gain_changes_glide_instead_of_stepping() {
         "early {early}, late {late}: ratio {ratio}"
     );
 }
+
+#[test]
+fn gains_at_a_strike_point_match_mode_by_mode() {
+    let banks = modal_resonator::model::factory::analytic_factory_banks();
+    let mut blended = 0;
+    for bank in banks.iter().filter(|b| b.positions.len() > 1) {
+        let prepared = modal_resonator::engine::PreparedBank::new(bank);
+        let mut all = vec![f32::NAN; prepared.num_modes()];
+        for (x, y) in [
+            (0.0, 0.0),
+            (0.13, 0.71),
+            (0.5, 0.5),
+            (0.9, 0.35),
+            (1.0, 1.0),
+        ] {
+            let w = prepared.positions.weights(x, y);
+            blended += (w.count > 1) as usize;
+            prepared.gains_at(&w, &mut all);
+            for (m, &g) in all.iter().enumerate() {
+                let one = prepared.gain_at(m, &w);
+                assert!(
+                    g == one,
+                    "{}: mode {m} at ({x}, {y}): {g} in one pass, {one} alone",
+                    bank.name
+                );
+            }
+        }
+    }
+    assert!(blended > 0, "no strike point blends positions");
+}

@@ -30,6 +30,9 @@ pub struct PreparedBank {
     pub ln_freq_ratio: Vec<f64>,
     /// Gains, mode-major: `gains[m * num_positions + k]`, scaled by the loudness normalisation.
     pub gains: Vec<f32>,
+    /// The same gains position-major, `[k * num_modes + m]`: a strike reads a position's column
+    /// of every mode at once.
+    gains_by_position: Vec<f32>,
     /// Number of strike positions.
     pub num_positions: usize,
     /// The positions, normalised.
@@ -69,6 +72,7 @@ impl PreparedBank {
             ln_freq_ratio: freq_hz.iter().map(|f| (f / lowest).ln()).collect(),
             freq_hz,
             gains,
+            gains_by_position: Vec::new(),
             num_positions: k,
             positions: PositionMap::new(&coords),
             root_key: hz_to_midi_key(bank.effective_root_hz()),
@@ -82,6 +86,10 @@ impl PreparedBank {
                 *g *= prepared.normalization;
             }
         }
+        let n = prepared.num_modes();
+        prepared.gains_by_position = (0..k * n)
+            .map(|i| prepared.gains[(i % n) * k + i / n])
+            .collect();
         prepared
     }
 
@@ -96,6 +104,28 @@ impl PreparedBank {
     /// Number of modes.
     pub fn num_modes(&self) -> usize {
         self.freq_hz.len()
+    }
+
+    /// Every mode's gain at strike point `w` into `out` (one per mode, as [`Self::gain_at`] gives
+    /// them), a position at a time.
+    pub fn gains_at(&self, w: &PositionWeights, out: &mut [f32]) {
+        let n = self.num_modes();
+        let out = &mut out[..n];
+        let column = |i: usize| &self.gains_by_position[w.index[i] * n..(w.index[i] + 1) * n];
+        if w.count == 0 {
+            out.fill(0.0);
+            return;
+        }
+        let weight = w.weight[0];
+        for (o, &g) in out.iter_mut().zip(column(0)) {
+            *o = weight * g;
+        }
+        for i in 1..w.count {
+            let weight = w.weight[i];
+            for (o, &g) in out.iter_mut().zip(column(i)) {
+                *o += weight * g;
+            }
+        }
     }
 
     /// Gain of mode `m` for a strike blended by `w`.

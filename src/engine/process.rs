@@ -420,6 +420,7 @@ impl Engine {
             y += vary * self.rng.bipolar();
         }
         let weights = self.bank.positions.weights(x, y);
+        self.bank.gains_at(&weights, &mut self.strike_gains);
         // Force: velocity^(2 s); contact: up to 4x longer for soft notes.
         let velocity = pending.velocity;
         let amplitude = velocity.powf(2.0 * c.velocity_sensitivity);
@@ -437,14 +438,14 @@ impl Engine {
             &self.decay,
             self.sample_rate_hz,
             tuning,
-            &weights,
+            &self.strike_gains,
             kind,
             amplitude,
             len,
             threshold,
         );
         if dormant {
-            self.settle_strike(i, kind, amplitude, len, &weights);
+            self.settle_strike(i, kind, amplitude, len);
         }
     }
 
@@ -558,6 +559,7 @@ impl Engine {
                     .bank
                     .positions
                     .weights(self.controls.strike_x, self.controls.strike_y);
+                self.bank.gains_at(&weights, &mut self.strike_gains);
                 let Some(v) = self.input_voice.as_mut() else {
                     return;
                 };
@@ -571,7 +573,7 @@ impl Engine {
                     &self.decay,
                     self.sample_rate_hz,
                     tuning,
-                    &weights,
+                    &self.strike_gains,
                     ExciterKind::Impulse,
                     0.0,
                     1,

@@ -2,7 +2,6 @@
 
 use std::f64::consts::TAU;
 
-use super::position::PositionWeights;
 use super::prepared::PreparedBank;
 use super::{NoteExpression, VoiceModulation, MAX_EXPRESSION_SEMITONES};
 use crate::dsp::coeffs::{t60_to_decay, ModeCoeffs, MAX_FREQ_RATIO};
@@ -194,8 +193,8 @@ impl Voice {
     }
 
     /// Strikes the voice: restarts modes that have died (unless the strike cannot lift them above
-    /// `threshold`), sets every mode's gain for the strike point `weights`, tunes the voice to
-    /// `tuning` and starts the pulse.
+    /// `threshold`), sets every mode's gain to `gains` (the bank's at the strike point), tunes the
+    /// voice to `tuning` and starts the pulse.
     #[allow(clippy::too_many_arguments)] // one call site; the values are all distinct and plain
     pub fn strike(
         &mut self,
@@ -203,7 +202,7 @@ impl Voice {
         decay: &[f64],
         sample_rate_hz: f64,
         tuning: Tuning,
-        weights: &PositionWeights,
+        gains: &[f32],
         kind: ExciterKind,
         amplitude: f32,
         len_samples: u32,
@@ -213,13 +212,13 @@ impl Voice {
         let bound = amplitude * kind.peak_bound(len_samples);
         // Modes left out share the threshold's energy, like modes retired later.
         let threshold = threshold / (bank.num_modes().max(1) as f32).sqrt();
-        for m in 0..bank.num_modes() {
-            if self.modes.is_live(m) {
+        for (m, &gain) in gains[..bank.num_modes()].iter().enumerate() {
+            let heard = gain.abs() * bound >= threshold;
+            if !heard || self.modes.is_live(m) {
                 continue;
             }
-            let gain = bank.gain_at(m, weights);
             let theta = TAU * bank.freq_hz[m] * pitch / sample_rate_hz;
-            if theta < THETA_MAX && gain.abs() * bound >= threshold {
+            if theta < THETA_MAX {
                 // Coefficients follow below, for all modes at once.
                 self.modes.activate(
                     m,
@@ -231,7 +230,7 @@ impl Voice {
                 );
             }
         }
-        self.modes.set_gains_with(|m| bank.gain_at(m, weights));
+        self.modes.set_gains_with(|m| gains[m]);
         self.retune(bank, decay, sample_rate_hz, tuning);
         self.exciter.strike(kind, amplitude, len_samples);
     }

@@ -17,7 +17,7 @@ use super::{samples_to_cross, OffReason, NO_TAG};
 use crate::dsp::masking::{power_to_db, DB_PER_NEPER};
 use crate::dsp::resonator_bank::{Pulse, PulseShape};
 use crate::dsp::ExciterKind;
-use crate::engine::{Engine, PositionWeights};
+use crate::engine::Engine;
 
 impl Engine {
     /// Before voice `i` is struck by `kind`: modes fading in or out are woken (through their
@@ -49,8 +49,8 @@ impl Engine {
         modes.num_dormant() > 0
     }
 
-    /// After voice `i` has been struck by `kind` of `amplitude` over `len` samples at strike
-    /// point `weights`: its dormant modes take the pulse analytically, and those it makes
+    /// After voice `i` has been struck by `kind` of `amplitude` over `len` samples with the gains
+    /// in `strike_gains`: its dormant modes take the pulse analytically, and those it makes
     /// audible are woken.
     pub(in crate::engine) fn settle_strike(
         &mut self,
@@ -58,7 +58,6 @@ impl Engine {
         kind: ExciterKind,
         amplitude: f32,
         len: u32,
-        weights: &PositionWeights,
     ) {
         let shape = match kind {
             ExciterKind::Impulse => PulseShape::Impulse,
@@ -71,14 +70,14 @@ impl Engine {
             amplitude,
             len,
         };
-        let bank = &self.bank;
+        let gains = &self.strike_gains;
         let modes = &mut self.voices[i].modes;
         self.pruner.stats.absorbed += modes.num_dormant() as u64;
         // With pruning the modes are judged below; a budget alone looks at the next frame.
         let pruning = self.controls.pruning;
-        modes.absorb_strike(pulse, !pruning, |m| bank.gain_at(m, weights));
+        modes.absorb_strike(pulse, !pruning, |m| gains[m]);
         if pruning {
-            self.judge_struck(i, amplitude * kind.peak_bound(len), weights);
+            self.judge_struck(i, amplitude * kind.peak_bound(len));
         }
         if let Some(start) = start {
             self.pruner.stats.strike_ns += start.elapsed().as_nanos() as u64;
@@ -86,8 +85,8 @@ impl Engine {
     }
 
     /// Wakes the dormant modes of voice `i` that a strike adding up to `bound` times each
-    /// mode's gain at `weights` (already taken by the dormant modes) makes audible.
-    fn judge_struck(&mut self, i: usize, bound: f32, weights: &PositionWeights) {
+    /// mode's gain in `strike_gains` (already taken by the dormant modes) makes audible.
+    fn judge_struck(&mut self, i: usize, bound: f32) {
         let calibration_db = self.calibration_db();
         let Engine {
             pruner: p,
@@ -95,7 +94,7 @@ impl Engine {
             controls: c,
             sample_rate_hz,
             clock,
-            bank,
+            strike_gains: gains,
             ..
         } = self;
         let now = *clock;
@@ -135,7 +134,7 @@ impl Engine {
                 match modes.state(masker) {
                     Some((re, im)) => {
                         let a = (re * re + im * im).sqrt();
-                        let lifted = a + bank.gain_at(masker, weights).abs() * bound;
+                        let lifted = a + gains[masker].abs() * bound;
                         power_to_db(lifted * lifted) - power_to_db(a * a)
                     }
                     None => f32::NEG_INFINITY,
@@ -171,7 +170,7 @@ impl Engine {
         // The voice's computed modes as the strike leaves them, to mask the lifted ones.
         let cands = &mut p.cands;
         modes.for_each_active(|m| {
-            let a = m.power.sqrt() + bank.gain_at(m.mode, weights).abs() * bound;
+            let a = m.power.sqrt() + gains[m.mode].abs() * bound;
             cands.push(
                 i,
                 generation,
