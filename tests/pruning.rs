@@ -360,3 +360,53 @@ fn a_budget_holds_within_a_control_period_of_a_strike() {
         "more than the budget computed at full level: {s:?}"
     );
 }
+
+/// The first time, in seconds from now, at which mode `m` is computed again, looking every
+/// analysis frame for up to `seconds`.
+fn first_heard(e: &mut Engine, m: usize, seconds: f64) -> Option<f64> {
+    let frame = e.controls().analysis_frame_ms as f64 * 1e-3;
+    let mut t = 0.0;
+    while t < seconds {
+        run(e, frame);
+        t += frame;
+        if !switched_off(e).contains(&m) {
+            return Some(t);
+        }
+    }
+    None
+}
+
+#[test]
+fn a_masked_mode_surfaces_on_time_after_a_strike_that_leaves_it_masked() {
+    // A loud mode that dies fast masks a quiet one that rings on, until its curve has fallen
+    // below it, about half a second later.
+    let bank = simple_bank(&[(1000.0, 8.0, 1.0), (1060.0, 0.5, 0.01)]);
+    let surfaces = |restrike: bool| {
+        let mut e = pruned_engine(&bank);
+        let mut c = e.controls().clone();
+        c.velocity_sensitivity = 1.0;
+        e.set_controls(&c);
+        let quiet = mode_at(&e, 1060.0);
+        strike(&mut e, 0.1);
+        assert_eq!(switched_off(&e), vec![quiet], "the quiet mode is masked");
+        let mut t = 0.1;
+        if restrike {
+            // A strike too light to lift either mode much: the quiet one stays masked.
+            let key = root(&e);
+            render(&mut e, &[on(0, key, 0.05)], 0.1, 256);
+            assert_eq!(
+                switched_off(&e),
+                vec![quiet],
+                "still masked after the light strike"
+            );
+            t += 0.1;
+        }
+        t + first_heard(&mut e, quiet, 2.0).expect("the quiet mode surfaces")
+    };
+    let (alone, struck) = (surfaces(false), surfaces(true));
+    assert!(alone < 0.9, "surfaced at {alone:.3} s");
+    assert!(
+        (struck - alone).abs() < 0.1,
+        "surfaced at {struck:.3} s after a light strike, {alone:.3} s without"
+    );
+}

@@ -112,14 +112,15 @@ impl ResonatorBank {
             return;
         }
         let now = self.clock;
-        // The earliest of the times not due now; those due are set again by the pruner.
+        // The earliest time of all, those visited included: the caller may leave a visited
+        // mode's time as it is (the next scan then finds it again, until it is set later).
         let mut earliest = u64::MAX;
         for (d, &recheck_at) in self.dormant[..self.num_dormant]
             .iter()
             .zip(&self.recheck[..self.num_dormant])
         {
+            earliest = earliest.min(recheck_at);
             if recheck_at > due {
-                earliest = earliest.min(recheck_at);
                 continue;
             }
             if self.slot_of_mode[d.mode as usize] != NONE {
