@@ -29,7 +29,7 @@ pub enum Verdict {
     Inaudible,
     /// Under the masking curve of candidate `by`.
     Masked {
-        /// Index of the candidate whose curve lies highest above this one.
+        /// Index of the first (loudest) masker whose curve lies above this one.
         by: u32,
     },
 }

@@ -29,6 +29,7 @@ pub struct PreparedBank {
     /// `ln(f / f_lowest)` of each mode, for the damping tilt.
     pub ln_freq_ratio: Vec<f64>,
     /// Gains, mode-major: `gains[m * num_positions + k]`, scaled by the loudness normalisation.
+    /// Read-only once prepared: `gains_by_position` holds them too.
     pub gains: Vec<f32>,
     /// The same gains position-major, `[k * num_modes + m]`: a strike reads a position's column
     /// of every mode at once.

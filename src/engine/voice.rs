@@ -195,7 +195,7 @@ impl Voice {
     /// Strikes the voice: restarts modes that have died (unless the strike cannot lift them above
     /// `threshold`), sets every mode's gain to `gains` (the bank's at the strike point), tunes the
     /// voice to `tuning` and starts the pulse.
-    #[allow(clippy::too_many_arguments)] // one call site; the values are all distinct and plain
+    #[allow(clippy::too_many_arguments)] // two call sites; the values are all distinct and plain
     pub fn strike(
         &mut self,
         bank: &PreparedBank,

@@ -155,7 +155,7 @@ fn the_budget_keeps_the_most_energetic() {
 #[test]
 fn a_masked_mode_names_the_loudest_masker_whose_curve_covers_it() {
     // Twenty maskers, 2 Bark apart from 1 Bark, falling 1 dB each from 80 dB: more than two
-    // lanes' worth. Probes at 30 dB, far below every curve within reach and beside one masker
+    // chunks of eight lanes. Probes at 30 dB, far below every curve within reach and beside one masker
     // each: the masker named is the loudest whose curve lies above the probe, which the
     // pairwise check finds too, whatever lane it sits in.
     let n_maskers = 20;

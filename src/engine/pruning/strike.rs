@@ -21,8 +21,8 @@ use crate::engine::Engine;
 
 impl Engine {
     /// Before voice `i` is struck by `kind`: modes fading in or out are woken (through their
-    /// poles they cannot take input), and every dormant one too for noise. Returns the shape the
-    /// dormant modes are to take analytically with [`Engine::settle_strike`], if any remain.
+    /// poles they cannot take input), and every dormant one too for noise. Returns whether
+    /// dormant modes remain, to take the strike analytically with [`Engine::settle_strike`].
     pub(in crate::engine) fn prepare_strike(&mut self, i: usize, kind: ExciterKind) -> bool {
         self.pruner.struck[i] = true;
         // Under a budget, the modes the strike starts are ranked at the next control tick rather
