@@ -258,12 +258,7 @@ impl MaskingPass {
     /// time, with AVX2 when the CPU has it.
     #[inline]
     fn envelope_at(&self, bark: f32) -> f32 {
-        let used = self.num_maskers.div_ceil(LANES) * LANES;
-        let (mb, peak, su) = (
-            &self.masker_bark[..used],
-            &self.masker_peak[..used],
-            &self.masker_upper_slope[..used],
-        );
+        let (mb, peak, su) = self.masker_lanes();
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
             // SAFETY: `avx2` is only set when the CPU supports AVX2 and FMA.
@@ -275,18 +270,23 @@ impl MaskingPass {
     /// The first masker (loudest first) whose curve at `bark` lies above `level_db`, eight lanes
     /// at a time, with AVX2 when the CPU has it.
     fn masker_above(&self, bark: f32, level_db: f32) -> usize {
-        let used = self.num_maskers.div_ceil(LANES) * LANES;
-        let (mb, peak, su) = (
-            &self.masker_bark[..used],
-            &self.masker_peak[..used],
-            &self.masker_upper_slope[..used],
-        );
+        let (mb, peak, su) = self.masker_lanes();
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
             // SAFETY: `avx2` is only set when the CPU supports AVX2 and FMA.
             return unsafe { first_above_avx2(mb, peak, su, bark, level_db) }.unwrap_or(0);
         }
         first_above(mb, peak, su, bark, level_db).unwrap_or(0)
+    }
+
+    /// The maskers' bark, peak and upper slope, padded to a whole number of lanes.
+    fn masker_lanes(&self) -> (&[f32], &[f32], &[f32]) {
+        let used = self.num_maskers.div_ceil(LANES) * LANES;
+        (
+            &self.masker_bark[..used],
+            &self.masker_peak[..used],
+            &self.masker_upper_slope[..used],
+        )
     }
 
     fn push_masker(&mut self, index: usize, bark: f32, level_db: f32, offset_db: f32) {
