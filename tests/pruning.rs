@@ -6,8 +6,8 @@ mod common;
 
 use common::*;
 use modal_resonator::dsp::ExciterKind;
-use modal_resonator::engine::{Engine, NoteEvent};
-use modal_resonator::model::Bank;
+use modal_resonator::engine::{Controls, Engine, NoteEvent, CONTROL_PERIOD};
+use modal_resonator::model::{Bank, Mode, Position};
 
 const RATE: f32 = 48_000.0;
 
@@ -409,4 +409,159 @@ fn a_masked_mode_surfaces_on_time_after_a_strike_that_leaves_it_masked() {
         (struck - alone).abs() < 0.1,
         "surfaced at {struck:.3} s after a light strike, {alone:.3} s without"
     );
+}
+
+/// Energy of `x` in dB.
+fn energy_db(x: &[f32]) -> f64 {
+    10.0 * x
+        .iter()
+        .map(|&s| (s as f64) * (s as f64))
+        .sum::<f64>()
+        .log10()
+}
+
+/// A bank struck at one of two ends: `a` excites the first group of `(freq_hz, gain)` modes
+/// and, by `leak` times their gains, the second; `b` excites only the second. Every mode decays
+/// at `decay_per_s`.
+fn two_ends_bank(first: &[(f64, f64)], second: &[(f64, f64)], leak: f64, decay_per_s: f64) -> Bank {
+    let mut bank = Bank::new(
+        "two ends",
+        vec![
+            Position {
+                name: "a".into(),
+                coords: vec![0.0],
+            },
+            Position {
+                name: "b".into(),
+                coords: vec![1.0],
+            },
+        ],
+    );
+    let mode = |freq_hz: f64, gains: Vec<f64>| Mode {
+        freq_hz,
+        decay_per_s,
+        gains,
+    };
+    bank.modes = first
+        .iter()
+        .map(|&(f, g)| mode(f, vec![g, 0.0]))
+        .chain(second.iter().map(|&(f, g)| mode(f, vec![leak * g, g])))
+        .collect();
+    bank.modes.sort_by(|a, b| a.freq_hz.total_cmp(&b.freq_hz));
+    bank.root_hz = Some(first[0].0);
+    bank
+}
+
+/// Strikes the root at end `a` of `bank`, lets it ring, then strikes it again at end `b`, with
+/// `setup` applied to the controls; returns the output from the second strike on.
+fn restrike(bank: &Bank, setup: impl Fn(&mut Controls)) -> Vec<f32> {
+    let mut e = pruned_engine(bank);
+    let mut c = e.controls().clone();
+    c.strike_x = 0.0;
+    setup(&mut c);
+    e.set_controls(&c);
+    let key = root(&e);
+    render(&mut e, &[on(0, key, 1.0)], 0.2, 256);
+    c.strike_x = 1.0;
+    e.set_controls(&c);
+    render(&mut e, &[on(0, key, 1.0)], 0.02, 256).0
+}
+
+#[test]
+fn a_strike_on_modes_the_budget_switched_off_plays_the_strongest_at_once() {
+    // Twenty modes at each end, their gains falling by 0.7 a mode; end b's are twice as loud.
+    // Struck at a, the budget of six keeps a's strongest and switches off every mode of b.
+    let group = |f0: f64, g0: f64| -> Vec<(f64, f64)> {
+        (0..20)
+            .map(|k| (f0 * 1.15f64.powi(k), g0 * 0.7f64.powi(k)))
+            .collect()
+    };
+    let bank = two_ends_bank(&group(200.0, 0.3), &group(230.0, 0.6), 0.01, 2.0);
+    for pruning in [false, true] {
+        let free = restrike(&bank, |c| c.pruning = pruning);
+        let capped = restrike(&bank, |c| {
+            c.pruning = pruning;
+            c.mode_budget = 6;
+        });
+        // Struck at b, the modes of b that outrank what the budget kept play from the strike's
+        // first sample, as they do with no budget; the weaker ones, which it would not keep,
+        // stay off. Without waking them, they would only fade in after the next control tick
+        // (an error within a dB of the whole attack).
+        let attack = CONTROL_PERIOD;
+        let diff: Vec<f32> = capped[..attack]
+            .iter()
+            .zip(&free[..attack])
+            .map(|(a, b)| a - b)
+            .collect();
+        let error_db = energy_db(&diff) - energy_db(&free[..attack]);
+        assert!(
+            error_db < -10.0,
+            "pruning {pruning}: the attack under the budget is {error_db:.1} dB off"
+        );
+    }
+}
+
+#[test]
+fn modes_a_strike_wakes_under_a_budget_do_not_push_out_stronger_ones() {
+    // Four long, strong modes at one end; forty short, weaker ones at the other.
+    let mut bank = Bank::new(
+        "two ends",
+        vec![
+            Position {
+                name: "a".into(),
+                coords: vec![0.0],
+            },
+            Position {
+                name: "b".into(),
+                coords: vec![1.0],
+            },
+        ],
+    );
+    let strong = |k: usize| Mode {
+        freq_hz: 200.0 + 30.0 * k as f64,
+        decay_per_s: 0.3,
+        gains: vec![1.0, 0.0],
+    };
+    let weak = |k: usize| Mode {
+        freq_hz: 1000.0 * 1.05f64.powi(k as i32),
+        decay_per_s: 5.0,
+        gains: vec![0.0, 0.3 / (1.0 + 0.05 * k as f64)],
+    };
+    bank.modes = (0..4).map(strong).chain((0..40).map(weak)).collect();
+    bank.root_hz = Some(200.0);
+    for pruning in [false, true] {
+        let mut e = pruned_engine(&bank);
+        let mut c = e.controls().clone();
+        c.pruning = pruning;
+        c.mode_budget = 10;
+        c.velocity_sensitivity = 1.0;
+        c.strike_x = 0.0;
+        e.set_controls(&c);
+        let key = root(&e);
+        // One voice rings with the strong modes; another softly with the weak ones, most of
+        // which the budget switches off.
+        render(&mut e, &[on(0, key, 1.0)], 0.05, 64);
+        c.strike_x = 1.0;
+        e.set_controls(&c);
+        render(&mut e, &[on(0, key + 2, 0.1)], 0.05, 64);
+        let off = switched_off(&e);
+        assert!(off.len() > 20, "pruning {pruning}: {off:?}");
+        // The soft voice struck hard: its modes wake as far as the budget has room beside
+        // the strong ones, which it keeps.
+        render(&mut e, &[on(0, key + 2, 1.0)], 0.02, 64);
+        let off = switched_off(&e);
+        assert!(
+            (0..4).all(|m| !off.contains(&m)),
+            "pruning {pruning}: strong modes switched off: {off:?}"
+        );
+        let s = e.stats();
+        assert!(
+            s.live_modes - s.dormant_modes - s.fading_modes <= 10,
+            "pruning {pruning}: more than the budget computed at full level: {s:?}"
+        );
+        assert!(
+            e.pruning_stats().woken > 0,
+            "pruning {pruning}: the strike woke nothing"
+        );
+    }
 }

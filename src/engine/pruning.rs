@@ -31,6 +31,7 @@
 
 mod analysis;
 mod candidates;
+mod kept;
 mod maskers;
 mod off_reason;
 mod strike;
@@ -40,6 +41,7 @@ use super::{Engine, CONTROL_PERIOD};
 use crate::dsp::pruning::MaskingPass;
 use crate::dsp::resonator_bank::DormantMode;
 use candidates::Candidates;
+use kept::KeptEnergies;
 use maskers::Maskers;
 use off_reason::OffReason;
 
@@ -134,8 +136,10 @@ pub(super) struct Pruner {
     pass: MaskingPass,
     /// The modes the analysis in hand looks at.
     cands: Candidates,
-    /// Budget ranking scratch: energy and candidate index.
+    /// Budget ranking scratch: energy and candidate index (at a strike, mode).
     ranked: Vec<(f32, u32)>,
+    /// The energies the budget kept at its last ranking.
+    kept: KeptEnergies,
     /// Maskers carried over.
     maskers: Maskers,
     /// Bark of the maskers handed to a pass.
@@ -191,6 +195,7 @@ impl Pruner {
             pass: MaskingPass::default(),
             cands: Candidates::new(0, 0),
             ranked: Vec::new(),
+            kept: KeptEnergies::new(),
             maskers: Maskers::default(),
             prior_bark: Vec::new(),
             prior_level_db: Vec::new(),

@@ -210,8 +210,7 @@ impl Voice {
     ) {
         let pitch = tuning.log_pitch.exp();
         let bound = amplitude * kind.peak_bound(len_samples);
-        // Modes left out share the threshold's energy, like modes retired later.
-        let threshold = threshold / (bank.num_modes().max(1) as f32).sqrt();
+        let threshold = start_threshold(threshold, bank.num_modes());
         for (m, &gain) in gains[..bank.num_modes()].iter().enumerate() {
             let heard = gain.abs() * bound >= threshold;
             if !heard || self.modes.is_live(m) {
@@ -234,4 +233,11 @@ impl Voice {
         self.retune(bank, decay, sample_rate_hz, tuning);
         self.exciter.strike(kind, amplitude, len_samples);
     }
+}
+
+/// What a strike must add to a mode of a bank of `num_modes` to start it, for truncation
+/// threshold `threshold` (as an amplitude): modes left out share the threshold's energy, like
+/// modes retired later.
+pub fn start_threshold(threshold: f32, num_modes: usize) -> f32 {
+    threshold / (num_modes.max(1) as f32).sqrt()
 }

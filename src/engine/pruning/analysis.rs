@@ -197,6 +197,8 @@ impl Engine {
                     cd.flags[i as usize] |= OVER_BUDGET;
                 }
             }
+            let kept = keep.min(p.ranked.len());
+            p.kept.record(p.ranked[..kept].iter().map(|&(e, _)| e));
         }
 
         // Switch modes off and on, and note when to look at each again.

@@ -44,6 +44,13 @@ impl Reading {
     }
 }
 
+/// Energy still to come in dB (seed 000 eq. 5.15, per-sample units) of a mode of power `raw_db`
+/// and pole `(theta, delta)`: `a^2 w^2 / (4 alpha (alpha^2 + w^2))`. What the budget ranks.
+pub(super) fn energy_db(raw_db: f32, theta: f64, delta: f64) -> f32 {
+    let (w, a) = (theta as f32, (delta as f32).max(1e-12));
+    raw_db + power_to_db(w * w / (4.0 * a * (a * a + w * w)))
+}
+
 /// The candidates of one analysis.
 #[derive(Debug, Clone)]
 pub(super) struct Candidates {
@@ -138,9 +145,7 @@ impl Candidates {
         self.fall_db[i] = DB_PER_NEPER * delta as f32;
         self.theta[i] = theta as f32;
         if reading.budget {
-            // Seed 000 eq. 5.15 in dB, per-sample units: a^2 w^2 / (4 alpha (alpha^2 + w^2)).
-            let (w, a) = (theta as f32, (delta as f32).max(1e-12));
-            self.energy_db[i] = raw_db + power_to_db(w * w / (4.0 * a * (a * a + w * w)));
+            self.energy_db[i] = energy_db(raw_db, theta, delta);
         }
         self.who[i] = ((voice as u32) << 24) | mode as u32;
         self.flags[i] = flags;

@@ -9,14 +9,21 @@
 //! voice's own computed modes as the strike leaves them; those found audible are woken at the
 //! strike's exact sample and compute it from its first sample, their old ringing fading back in
 //! beside them. A noise burst is not known in advance: it wakes them all.
+//!
+//! Under a budget, only as many are woken as the budget would keep, ranked by energy with what
+//! it kept at its last ranking ([`super::kept`]); the next control tick ranks everything again.
+//! With the budget alone the modes judged are those the strike lifts as far as it would start a
+//! silent one.
 
 use std::time::Instant;
 
-use super::candidates::{Reading, DORMANT, DRIVEN};
+use super::candidates::{energy_db, Reading, DORMANT, DRIVEN};
 use super::{samples_to_cross, OffReason, NO_TAG};
+use crate::dsp::coeffs::db_to_gain;
 use crate::dsp::masking::{power_to_db, DB_PER_NEPER};
 use crate::dsp::resonator_bank::{Pulse, PulseShape};
 use crate::dsp::ExciterKind;
+use crate::engine::voice::start_threshold;
 use crate::engine::Engine;
 
 impl Engine {
@@ -73,20 +80,74 @@ impl Engine {
         let gains = &self.strike_gains;
         let modes = &mut self.voices[i].modes;
         self.pruner.stats.absorbed += modes.num_dormant() as u64;
-        // With pruning the modes are judged below; a budget alone looks at the next frame.
+        let bound = amplitude * kind.peak_bound(len);
+        let cap = self.budget.cap(&self.controls, self.sample_rate_hz);
+        // With pruning the modes are judged below; otherwise the next analysis looks at them.
         let pruning = self.controls.pruning;
         modes.absorb_strike(pulse, !pruning, |m| gains[m]);
         if pruning {
-            self.judge_struck(i, amplitude * kind.peak_bound(len));
+            self.judge_struck(i, bound, cap);
+        } else if let Some(cap) = cap {
+            self.wake_within_budget(i, bound, cap);
         }
         if let Some(start) = start {
             self.pruner.stats.strike_ns += start.elapsed().as_nanos() as u64;
         }
     }
 
+    /// Under a budget alone: of the dormant modes of voice `i` (all switched off by the budget),
+    /// those a strike adding up to `bound` times each mode's gain in `strike_gains` lifts as far
+    /// as it would start a silent one are woken, as many as the budget would keep.
+    fn wake_within_budget(&mut self, i: usize, bound: f32, cap: usize) {
+        let threshold = start_threshold(
+            db_to_gain(self.controls.truncation_db),
+            self.bank.num_modes(),
+        );
+        let Engine {
+            pruner: p,
+            voices,
+            strike_gains: gains,
+            ..
+        } = self;
+        p.ranked.clear();
+        let ranked = &mut p.ranked;
+        voices[i].modes.for_each_dormant(u64::MAX, |d| {
+            if gains[d.mode].abs() * bound >= threshold {
+                ranked.push((energy_db(d.level_db, d.theta, d.delta), d.mode as u32));
+            }
+        });
+        let n = self.best_within_budget(cap);
+        let Engine { pruner, voices, .. } = self;
+        for &(_, mode) in &pruner.ranked[..n] {
+            voices[i].modes.wake(mode as usize);
+        }
+    }
+
+    /// Sorts the lifted modes in `pruner.ranked` (energy, and what they are) by energy and
+    /// returns how many of the first the budget `cap` would keep: ranked with what it kept at
+    /// its last ranking, within what the modes fading now leave (the next ranking cannot switch
+    /// those off). The modes woken go on at once; the next control tick ranks everything.
+    fn best_within_budget(&mut self, cap: usize) -> usize {
+        let fading: usize = self
+            .voices
+            .iter()
+            .chain(self.input_voice.as_ref())
+            .map(|v| v.modes.num_fading())
+            .sum();
+        let p = &mut self.pruner;
+        // Loudest first; NaN last.
+        let key = |e: f32| if e.is_nan() { f32::NEG_INFINITY } else { e };
+        p.ranked
+            .sort_unstable_by(|a, b| key(b.0).total_cmp(&key(a.0)));
+        let room = cap.saturating_sub(fading);
+        p.kept.how_many_fit(p.ranked.iter().map(|&(e, _)| e), room)
+    }
+
     /// Wakes the dormant modes of voice `i` that a strike adding up to `bound` times each
-    /// mode's gain in `strike_gains` (already taken by the dormant modes) makes audible.
-    fn judge_struck(&mut self, i: usize, bound: f32) {
+    /// mode's gain in `strike_gains` (already taken by the dormant modes) makes audible: under
+    /// a budget `cap`, only as many as it would keep, the others being left to the next
+    /// analysis.
+    fn judge_struck(&mut self, i: usize, bound: f32, cap: Option<usize>) {
         let calibration_db = self.calibration_db();
         let Engine {
             pruner: p,
@@ -98,7 +159,7 @@ impl Engine {
             ..
         } = self;
         let now = *clock;
-        let reading = Reading::new(calibration_db, *sample_rate_hz, false);
+        let reading = Reading::new(calibration_db, *sample_rate_hz, cap.is_some());
         let generation = p.generation[i];
         let stride = p.cands.stride;
         let modes = &mut voices[i].modes;
@@ -112,12 +173,9 @@ impl Engine {
         });
         p.num_rechecks = 0;
         for d in &p.dormant_scratch[..num_dormant] {
+            // A mode off for the budget is judged like a lifted one (its reason names no
+            // voice generation).
             let reason = p.off[i * stride + d.mode];
-            if reason == OffReason::BUDGET {
-                p.rechecks[p.num_rechecks] = (d.mode as u32, bank_now);
-                p.num_rechecks += 1;
-                continue;
-            }
             let stale_tag = d.tag != NO_TAG && {
                 let masker = (d.tag >> 24) as usize;
                 p.generation
@@ -186,16 +244,35 @@ impl Engine {
         p.stats.candidates += n as u64;
         let num_prior = p.gather_priors(now, Some(i));
         p.run_pass(num_prior, c.masking_offset_db);
+        p.ranked.clear();
         for k in 0..num_dormant {
             let mode = p.cands.voice_mode(k).1;
-            if p.cands.verdicts[k].is_audible() {
-                modes.wake(mode);
-            } else {
+            if !p.cands.verdicts[k].is_audible() {
                 let (delay, tag, reason) = p.when_off(k, c.masking_offset_db, now);
                 p.off[i * stride + mode] = reason;
                 modes.set_recheck(mode, bank_now + delay, tag);
+            } else if cap.is_some() {
+                p.ranked.push((p.cands.energy_db[k], mode as u32));
+            } else {
+                modes.wake(mode);
             }
         }
         p.cands.clear();
+        if let Some(cap) = cap {
+            let n = self.best_within_budget(cap);
+            let Engine {
+                pruner: p, voices, ..
+            } = self;
+            let modes = &mut voices[i].modes;
+            for (j, &(_, mode)) in p.ranked.iter().enumerate() {
+                if j < n {
+                    modes.wake(mode as usize);
+                } else {
+                    // Heard, but not within the budget now: the next analysis ranks it.
+                    p.off[i * stride + mode as usize] = OffReason::BUDGET;
+                    modes.set_recheck(mode as usize, bank_now, NO_TAG);
+                }
+            }
+        }
     }
 }
