@@ -15,8 +15,8 @@
 //!    that have become audible back in, in phase.
 //!
 //! A strike decides at once which of its voice's dormant modes it makes audible ([`strike`]):
-//! those are woken at its exact sample and take it computed; the others take it analytically and
-//! stay dormant. Audio input, which is not known in advance, wakes every dormant mode of the input
+//! those are woken at its exact sample and take it computed (under a budget, as many as the
+//! budget would keep); the others take it analytically and stay dormant. Audio input, which is not known in advance, wakes every dormant mode of the input
 //! voice.
 //!
 //! Most frames look only at what may have changed. Every level falls linearly in dB, so it is
@@ -31,7 +31,6 @@
 
 mod analysis;
 mod candidates;
-mod kept;
 mod maskers;
 mod off_reason;
 mod strike;
@@ -41,7 +40,6 @@ use super::{Engine, CONTROL_PERIOD};
 use crate::dsp::pruning::MaskingPass;
 use crate::dsp::resonator_bank::DormantMode;
 use candidates::Candidates;
-use kept::KeptEnergies;
 use maskers::Maskers;
 use off_reason::OffReason;
 
@@ -138,8 +136,8 @@ pub(super) struct Pruner {
     cands: Candidates,
     /// Budget ranking scratch: energy and candidate index (at a strike, mode).
     ranked: Vec<(f32, u32)>,
-    /// The energies the budget kept at its last ranking.
-    kept: KeptEnergies,
+    /// Scratch for a strike under a budget: the energies of the modes computed now.
+    computed_energy: Vec<f32>,
     /// Maskers carried over.
     maskers: Maskers,
     /// Bark of the maskers handed to a pass.
@@ -195,7 +193,7 @@ impl Pruner {
             pass: MaskingPass::default(),
             cands: Candidates::new(0, 0),
             ranked: Vec::new(),
-            kept: KeptEnergies::new(),
+            computed_energy: Vec::new(),
             maskers: Maskers::default(),
             prior_bark: Vec::new(),
             prior_level_db: Vec::new(),
@@ -228,6 +226,7 @@ impl Pruner {
         self.pass = MaskingPass::with_capacity(2 * n);
         self.cands = Candidates::new(num_voices, num_modes);
         self.ranked = Vec::with_capacity(n);
+        self.computed_energy = Vec::with_capacity(n);
         self.maskers = Maskers::with_capacity(n);
         self.prior_bark = vec![0.0; n];
         self.prior_level_db = vec![0.0; n];

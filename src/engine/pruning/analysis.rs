@@ -181,7 +181,10 @@ impl Engine {
             let mut locked = 0;
             for i in 0..n {
                 let f = cd.flags[i];
-                if f & DROP != 0 || !(cd.verdicts[i].is_audible() || f & LOCKED != 0) {
+                // A dormant mode waiting for its voice's drive to end is not computed: it
+                // takes no place.
+                let waiting = f & (DORMANT | LOCKED) == DORMANT | LOCKED;
+                if waiting || f & DROP != 0 || !(cd.verdicts[i].is_audible() || f & LOCKED != 0) {
                     continue;
                 }
                 if f & LOCKED != 0 {
@@ -197,8 +200,6 @@ impl Engine {
                     cd.flags[i as usize] |= OVER_BUDGET;
                 }
             }
-            let kept = keep.min(p.ranked.len());
-            p.kept.record(p.ranked[..kept].iter().map(|&(e, _)| e));
         }
 
         // Switch modes off and on, and note when to look at each again.

@@ -10,10 +10,9 @@
 //! strike's exact sample and compute it from its first sample, their old ringing fading back in
 //! beside them. A noise burst is not known in advance: it wakes them all.
 //!
-//! Under a budget, only as many are woken as the budget would keep, ranked by energy with what
-//! it kept at its last ranking ([`super::kept`]); the next control tick ranks everything again.
-//! With the budget alone the modes judged are those the strike lifts as far as it would start a
-//! silent one.
+//! Under a budget, only as many are woken as the budget would keep, ranked by energy with the
+//! modes computed now; the next control tick ranks everything again. With the budget alone the
+//! modes judged are those the strike lifts as far as it would start a silent one.
 
 use std::time::Instant;
 
@@ -24,7 +23,7 @@ use crate::dsp::masking::{power_to_db, DB_PER_NEPER};
 use crate::dsp::resonator_bank::{Pulse, PulseShape};
 use crate::dsp::ExciterKind;
 use crate::engine::voice::start_threshold;
-use crate::engine::Engine;
+use crate::engine::{Engine, CONTROL_PERIOD};
 
 impl Engine {
     /// Before voice `i` is struck by `kind`: modes fading in or out are woken (through their
@@ -58,7 +57,7 @@ impl Engine {
 
     /// After voice `i` has been struck by `kind` of `amplitude` over `len` samples with the gains
     /// in `strike_gains`: its dormant modes take the pulse analytically, and those it makes
-    /// audible are woken.
+    /// audible are woken (under a budget, as many as it would keep).
     pub(in crate::engine) fn settle_strike(
         &mut self,
         i: usize,
@@ -82,7 +81,8 @@ impl Engine {
         self.pruner.stats.absorbed += modes.num_dormant() as u64;
         let bound = amplitude * kind.peak_bound(len);
         let cap = self.budget.cap(&self.controls, self.sample_rate_hz);
-        // With pruning the modes are judged below; otherwise the next analysis looks at them.
+        // With pruning the modes are judged below; with a budget alone, ranked by energy;
+        // otherwise the next analysis looks at them.
         let pruning = self.controls.pruning;
         modes.absorb_strike(pulse, !pruning, |m| gains[m]);
         if pruning {
@@ -124,23 +124,58 @@ impl Engine {
     }
 
     /// Sorts the lifted modes in `pruner.ranked` (energy, and what they are) by energy and
-    /// returns how many of the first the budget `cap` would keep: ranked with what it kept at
-    /// its last ranking, within what the modes fading now leave (the next ranking cannot switch
-    /// those off). The modes woken go on at once; the next control tick ranks everything.
+    /// returns how many of the first the next ranking would keep under `cap`: ranked with every
+    /// mode computed now, at its level with the strikes under way added, after those that ranking
+    /// cannot switch off (fading, or in a voice a strike will still be driving then), which take
+    /// their places whatever their energy. The modes woken go on at once; the next control tick
+    /// ranks everything again.
     fn best_within_budget(&mut self, cap: usize) -> usize {
-        let fading: usize = self
-            .voices
-            .iter()
-            .chain(self.input_voice.as_ref())
-            .map(|v| v.modes.num_fading())
-            .sum();
-        let p = &mut self.pruner;
+        let period = CONTROL_PERIOD as u64;
+        // The tick on this sample has run before its events: the next is a period on at most.
+        let to_tick = period - self.clock % period;
+        let num_voices = self.voices.len();
+        let Engine {
+            pruner: p,
+            voices,
+            input_voice,
+            ..
+        } = self;
+        p.computed_energy.clear();
+        let mut locked = 0;
+        for (vi, v) in voices.iter().chain(input_voice.as_ref()).enumerate() {
+            // Audio input drives the input voice whenever it comes.
+            let driven = vi == num_voices || v.exciter.samples_left() as u64 > to_tick;
+            let pending = v.exciter.pending_bound();
+            let energies = &mut p.computed_energy;
+            v.modes.for_each_active(|m| {
+                if m.fading || driven {
+                    locked += 1;
+                } else {
+                    let a = m.power.sqrt() + m.gain.abs() * pending;
+                    energies.push(energy_db(power_to_db(a * a), m.theta, m.delta));
+                }
+            });
+        }
         // Loudest first; NaN last.
         let key = |e: f32| if e.is_nan() { f32::NEG_INFINITY } else { e };
         p.ranked
             .sort_unstable_by(|a, b| key(b.0).total_cmp(&key(a.0)));
-        let room = cap.saturating_sub(fading);
-        p.kept.how_many_fit(p.ranked.iter().map(|&(e, _)| e), room)
+        p.computed_energy
+            .sort_unstable_by(|a, b| key(*b).total_cmp(&key(*a)));
+        let room = cap.saturating_sub(locked);
+        // Lifted mode `j` is kept if it and the computed modes at least as energetic fit.
+        let mut louder = 0;
+        let mut fit = 0;
+        for (j, &(e, _)) in p.ranked.iter().enumerate() {
+            while louder < p.computed_energy.len() && key(p.computed_energy[louder]) >= key(e) {
+                louder += 1;
+            }
+            if j + louder >= room {
+                break;
+            }
+            fit = j + 1;
+        }
+        fit
     }
 
     /// Wakes the dormant modes of voice `i` that a strike adding up to `bound` times each
