@@ -525,13 +525,15 @@ fn modes_a_strike_wakes_under_a_budget_do_not_push_out_stronger_ones() {
         // Struck at a, the budget keeps the strong modes and a's strongest after them.
         render(&mut e, &[on(0, key, 1.0)], 0.2, 64);
         let woken = e.pruning_stats().woken;
-        // Struck at b: b's strongest outrank a's weaker ones and wake, but not the strong ones.
+        // Struck at b: b's strongest outrank a's weaker ones and wake, as many as fit beside
+        // the strong ones, which stay.
         c.strike_x = 1.0;
         e.set_controls(&c);
         render(&mut e, &[on(0, key, 1.0)], 0.02, 64);
+        let woken = e.pruning_stats().woken - woken;
         assert!(
-            e.pruning_stats().woken > woken,
-            "pruning {pruning}: the strike woke nothing"
+            (1..=5).contains(&woken),
+            "pruning {pruning}: the strike woke {woken} modes"
         );
         let off = switched_off(&e);
         assert!(
@@ -547,47 +549,50 @@ fn modes_a_strike_wakes_under_a_budget_do_not_push_out_stronger_ones() {
 }
 
 #[test]
-fn a_long_strike_on_one_voice_does_not_push_out_another_for_its_dormant_modes() {
-    // Strong modes at end a on one voice; end b's modes on another, mostly switched off by the
-    // budget, then struck by a mallet still in contact at the next control ticks. Until it
-    // lets go, that voice's modes cannot be switched; its dormant ones take no place.
+fn modes_that_cannot_be_switched_take_no_place_from_stronger_ones() {
+    // Strong modes at end a on one voice; thirty weaker modes at end b on another, struck by a
+    // mallet still in contact at the next control ticks: until it lets go, that voice's modes
+    // cannot be switched. They run over the budget rather than push the strong ones out,
+    // whether they start from rest or the budget had switched most of them off.
     let first: Vec<(f64, f64)> = vec![(200.0, 1.0), (230.0, 1.0), (260.0, 1.0)];
     let second: Vec<(f64, f64)> = (0..30)
         .map(|k| (430.0 * 1.1f64.powi(k), 0.1 * 0.95f64.powi(k)))
         .collect();
     let bank = two_ends_bank(&first, &second, 0.0, 2.0);
     for pruning in [false, true] {
-        let mut e = pruned_engine(&bank);
-        let strong: Vec<usize> = [200.0, 230.0, 260.0]
-            .iter()
-            .map(|&f| mode_at(&e, f))
-            .collect();
-        let mut c = e.controls().clone();
-        c.pruning = pruning;
-        c.mode_budget = 8;
-        c.strike_x = 0.0;
-        e.set_controls(&c);
-        let key = root(&e);
-        render(&mut e, &[on(0, key, 1.0)], 0.05, 64);
-        c.strike_x = 1.0;
-        e.set_controls(&c);
-        render(&mut e, &[on(0, key + 1, 1.0)], 0.05, 64);
-        assert!(
-            e.stats().dormant_modes > 10,
-            "pruning {pruning}: {:?}",
-            e.stats()
-        );
-        c.exciter = ExciterKind::Mallet;
-        c.hardness_ms = 10.0;
-        c.velocity_to_hardness = 0.0;
-        e.set_controls(&c);
-        // Long enough for a mode switched off at the next tick to have faded out (10 ms at
-        // 200 Hz), and before the next frame's analysis.
-        render(&mut e, &[on(0, key + 1, 1.0)], 0.012, 64);
-        let off = switched_off(&e);
-        assert!(
-            strong.iter().all(|m| !off.contains(m)),
-            "pruning {pruning}: strong modes {strong:?} switched off: {off:?}"
-        );
+        for dormant_first in [false, true] {
+            let mut e = pruned_engine(&bank);
+            let strong: Vec<usize> = [200.0, 230.0, 260.0]
+                .iter()
+                .map(|&f| mode_at(&e, f))
+                .collect();
+            let mut c = e.controls().clone();
+            c.pruning = pruning;
+            c.mode_budget = 8;
+            c.strike_x = 0.0;
+            e.set_controls(&c);
+            let key = root(&e);
+            render(&mut e, &[on(0, key, 1.0)], 0.05, 64);
+            c.strike_x = 1.0;
+            e.set_controls(&c);
+            if dormant_first {
+                // A short strike first: the budget switches most of b's modes off.
+                render(&mut e, &[on(0, key + 1, 1.0)], 0.05, 64);
+                assert!(e.stats().dormant_modes > 10, "{:?}", e.stats());
+            }
+            c.exciter = ExciterKind::Mallet;
+            c.hardness_ms = 10.0;
+            c.velocity_to_hardness = 0.0;
+            e.set_controls(&c);
+            // Long enough for a mode switched off at the next tick to have faded out (10 ms at
+            // 200 Hz), and before the next frame's analysis.
+            render(&mut e, &[on(0, key + 1, 1.0)], 0.012, 64);
+            let off = switched_off(&e);
+            assert!(
+                strong.iter().all(|m| !off.contains(m)),
+                "pruning {pruning}, dormant first {dormant_first}: strong modes {strong:?} \
+                 switched off: {off:?}"
+            );
+        }
     }
 }

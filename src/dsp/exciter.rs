@@ -113,15 +113,6 @@ impl Exciter {
         self.count == 0
     }
 
-    /// Samples until every strike under way has ended.
-    pub fn samples_left(&self) -> u32 {
-        self.pulses[..self.count]
-            .iter()
-            .map(|p| p.len.saturating_sub(p.pos))
-            .max()
-            .unwrap_or(0)
-    }
-
     /// Bound on how much the strikes still under way can add to a mode's amplitude, relative to
     /// its gain: the sum of their whole pulses' bounds ([`ExciterKind::peak_bound`]).
     pub fn pending_bound(&self) -> f32 {
@@ -225,23 +216,6 @@ mod tests {
             energy += buf.iter().map(|x| x * x).sum::<f32>();
         }
         (sum, energy)
-    }
-
-    #[test]
-    fn samples_left_counts_down_to_the_end_of_the_longest_strike() {
-        let mut e = Exciter::new(1);
-        assert_eq!(e.samples_left(), 0);
-        e.strike(ExciterKind::Mallet, 1.0, 100);
-        e.strike(ExciterKind::Impulse, 1.0, 100);
-        assert_eq!(e.samples_left(), 100);
-        let mut buf = [0.0; 30];
-        e.render(&mut buf);
-        assert_eq!(e.samples_left(), 70);
-        for _ in 0..3 {
-            e.render(&mut buf);
-        }
-        assert_eq!(e.samples_left(), 0);
-        assert!(e.is_idle());
     }
 
     #[test]

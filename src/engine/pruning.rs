@@ -174,7 +174,8 @@ pub(super) struct Pruner {
     since_dormant_full: u32,
     /// Whether modes may be dormant or fading somewhere.
     engaged: bool,
-    /// Whether the input has woken modes since the last analysis.
+    /// Whether the next control tick is to analyse: the input has woken modes, or a strike
+    /// came under a budget.
     pending: bool,
     /// The settings the last full look ran with: a change looks at everything again.
     settings: Option<(f32, bool, Option<usize>)>,

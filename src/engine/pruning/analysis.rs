@@ -175,28 +175,23 @@ impl Engine {
         }
         let cd = &mut p.cands;
 
-        // The budget: keep the most energetic of what is audible.
+        // The budget: keep the `cap` most energetic of what is audible. A mode that cannot be
+        // switched now (fading, or in a voice being driven) stays computed wherever it ranks,
+        // but takes no place from a stronger one: it runs over the cap until it can be switched.
         if let Some(cap) = cap {
             p.ranked.clear();
-            let mut locked = 0;
             for i in 0..n {
                 let f = cd.flags[i];
-                // A dormant mode waiting for its voice's drive to end is not computed: it
-                // takes no place.
+                // A dormant mode waiting for its voice's drive to end is not computed.
                 let waiting = f & (DORMANT | LOCKED) == DORMANT | LOCKED;
                 if waiting || f & DROP != 0 || !(cd.verdicts[i].is_audible() || f & LOCKED != 0) {
                     continue;
                 }
-                if f & LOCKED != 0 {
-                    locked += 1;
-                } else {
-                    p.ranked.push((cd.energy_db[i], i as u32));
-                }
+                p.ranked.push((cd.energy_db[i], i as u32));
             }
-            let keep = cap.saturating_sub(locked);
-            if keep < p.ranked.len() {
-                keep_most_energetic(&mut p.ranked, keep);
-                for &(_, i) in &p.ranked[keep..] {
+            if cap < p.ranked.len() {
+                keep_most_energetic(&mut p.ranked, cap);
+                for &(_, i) in &p.ranked[cap..] {
                     cd.flags[i as usize] |= OVER_BUDGET;
                 }
             }

@@ -14,7 +14,7 @@ impl Pruner {
         let (vi, _) = cd.voice_mode(i);
         let to_truncation = samples_to_cross(cd.raw_db[i] - self.truncation_db[vi], cd.fall_db[i]);
         if cd.flags[i] & OVER_BUDGET != 0 {
-            // Over budget: look again next frame; a strike judges it at once.
+            // Over budget: look again next frame, or when a strike lifts it.
             return (0, NO_TAG, OffReason::BUDGET);
         }
         match cd.verdicts[i] {
@@ -119,7 +119,7 @@ impl OffReason {
         masker: u32::MAX,
     };
 
-    /// Off for the budget: a strike judges it again, and wakes it if the budget has room.
+    /// Off for the budget: a strike on its voice may wake it, if the budget has room.
     pub const BUDGET: Self = Self {
         curve_db: f32::INFINITY,
         threshold_db: f32::INFINITY,

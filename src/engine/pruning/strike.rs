@@ -23,7 +23,8 @@ use crate::dsp::masking::{power_to_db, DB_PER_NEPER};
 use crate::dsp::resonator_bank::{Pulse, PulseShape};
 use crate::dsp::ExciterKind;
 use crate::engine::voice::start_threshold;
-use crate::engine::{Engine, CONTROL_PERIOD};
+use crate::engine::voice::VoiceState;
+use crate::engine::Engine;
 
 impl Engine {
     /// Before voice `i` is struck by `kind`: modes fading in or out are woken (through their
@@ -124,36 +125,30 @@ impl Engine {
     }
 
     /// Sorts the lifted modes in `pruner.ranked` (energy, and what they are) by energy and
-    /// returns how many of the first the next ranking would keep under `cap`: ranked with every
-    /// mode computed now, at its level with the strikes under way added, after those that ranking
-    /// cannot switch off (fading, or in a voice a strike will still be driving then), which take
-    /// their places whatever their energy. The modes woken go on at once; the next control tick
-    /// ranks everything again.
+    /// returns how many of the first rank within the budget `cap` among them and every mode
+    /// computed now (at its level with the strikes under way added), as the next ranking will
+    /// rank them. The modes woken go on at once; the next control tick ranks everything again.
     fn best_within_budget(&mut self, cap: usize) -> usize {
-        let period = CONTROL_PERIOD as u64;
-        // The tick on this sample has run before its events: the next is a period on at most.
-        let to_tick = period - self.clock % period;
-        let num_voices = self.voices.len();
         let Engine {
             pruner: p,
             voices,
             input_voice,
             ..
         } = self;
+        if p.ranked.is_empty() {
+            return 0;
+        }
         p.computed_energy.clear();
-        let mut locked = 0;
-        for (vi, v) in voices.iter().chain(input_voice.as_ref()).enumerate() {
-            // Audio input drives the input voice whenever it comes.
-            let driven = vi == num_voices || v.exciter.samples_left() as u64 > to_tick;
+        for v in voices.iter().chain(input_voice.as_ref()) {
+            // The ranking leaves out voices fading after being stolen.
+            if v.state == VoiceState::Fading {
+                continue;
+            }
             let pending = v.exciter.pending_bound();
             let energies = &mut p.computed_energy;
             v.modes.for_each_active(|m| {
-                if m.fading || driven {
-                    locked += 1;
-                } else {
-                    let a = m.power.sqrt() + m.gain.abs() * pending;
-                    energies.push(energy_db(power_to_db(a * a), m.theta, m.delta));
-                }
+                let a = m.power.sqrt() + m.gain.abs() * pending;
+                energies.push(energy_db(power_to_db(a * a), m.theta, m.delta));
             });
         }
         // Loudest first; NaN last.
@@ -162,7 +157,6 @@ impl Engine {
             .sort_unstable_by(|a, b| key(b.0).total_cmp(&key(a.0)));
         p.computed_energy
             .sort_unstable_by(|a, b| key(*b).total_cmp(&key(*a)));
-        let room = cap.saturating_sub(locked);
         // Lifted mode `j` is kept if it and the computed modes at least as energetic fit.
         let mut louder = 0;
         let mut fit = 0;
@@ -170,7 +164,7 @@ impl Engine {
             while louder < p.computed_energy.len() && key(p.computed_energy[louder]) >= key(e) {
                 louder += 1;
             }
-            if j + louder >= room {
+            if j + louder >= cap {
                 break;
             }
             fit = j + 1;
