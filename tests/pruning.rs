@@ -552,8 +552,8 @@ fn modes_a_strike_wakes_under_a_budget_do_not_push_out_stronger_ones() {
 fn modes_that_cannot_be_switched_take_no_place_from_stronger_ones() {
     // Strong modes at end a on one voice; thirty weaker modes at end b on another, struck by a
     // mallet still in contact at the next control ticks: until it lets go, that voice's modes
-    // cannot be switched. They run over the budget rather than push the strong ones out,
-    // whether they start from rest or the budget had switched most of them off.
+    // cannot be switched. They must not push the strong ones out, whether they start from rest
+    // or the budget had switched most of them off.
     let first: Vec<(f64, f64)> = vec![(200.0, 1.0), (230.0, 1.0), (260.0, 1.0)];
     let second: Vec<(f64, f64)> = (0..30)
         .map(|k| (430.0 * 1.1f64.powi(k), 0.1 * 0.95f64.powi(k)))
@@ -584,8 +584,8 @@ fn modes_that_cannot_be_switched_take_no_place_from_stronger_ones() {
             c.hardness_ms = 10.0;
             c.velocity_to_hardness = 0.0;
             e.set_controls(&c);
-            // Long enough for a mode switched off at the next tick to have faded out (10 ms at
-            // 200 Hz), and before the next frame's analysis.
+            // Long enough for a mode switched off at the tick after the strike to have faded out
+            // (10 ms at 200 Hz).
             render(&mut e, &[on(0, key + 1, 1.0)], 0.012, 64);
             let off = switched_off(&e);
             assert!(

@@ -14,7 +14,7 @@ impl Pruner {
         let (vi, _) = cd.voice_mode(i);
         let to_truncation = samples_to_cross(cd.raw_db[i] - self.truncation_db[vi], cd.fall_db[i]);
         if cd.flags[i] & OVER_BUDGET != 0 {
-            // Over budget: look again next frame, or when a strike lifts it.
+            // Over budget: look again next frame, or when its voice is struck.
             return (0, NO_TAG, OffReason::BUDGET);
         }
         match cd.verdicts[i] {
