@@ -521,19 +521,7 @@ fn the_mode_count_and_frequency_range_are_respected() {
 #[test]
 fn modes_closer_than_the_difference_limen_come_out_as_one() {
     // 1 Hz apart at 1 kHz, where the limen is 2.5 Hz (seed 000 section 5.4.1): one mode.
-    let mut bank = Bank::new(
-        "pair",
-        vec![
-            Position {
-                name: "a".into(),
-                coords: vec![0.0],
-            },
-            Position {
-                name: "b".into(),
-                coords: vec![1.0],
-            },
-        ],
-    );
+    let mut bank = Bank::new("pair", common::two_ends());
     for (freq_hz, decay_per_s, gains) in [
         (440.0, 2.0, vec![0.3, 0.2]),
         (1000.0, 3.0, vec![0.1, 0.05]),

@@ -7,7 +7,7 @@ mod common;
 use common::*;
 use modal_resonator::dsp::ExciterKind;
 use modal_resonator::engine::{Controls, Engine, NoteEvent, CONTROL_PERIOD};
-use modal_resonator::model::{Bank, Mode, Position};
+use modal_resonator::model::{Bank, Mode};
 
 const RATE: f32 = 48_000.0;
 
@@ -424,19 +424,7 @@ fn energy_db(x: &[f32]) -> f64 {
 /// and, by `leak` times their gains, the second; `b` excites only the second. Every mode decays
 /// at `decay_per_s`.
 fn two_ends_bank(first: &[(f64, f64)], second: &[(f64, f64)], leak: f64, decay_per_s: f64) -> Bank {
-    let mut bank = Bank::new(
-        "two ends",
-        vec![
-            Position {
-                name: "a".into(),
-                coords: vec![0.0],
-            },
-            Position {
-                name: "b".into(),
-                coords: vec![1.0],
-            },
-        ],
-    );
+    let mut bank = Bank::new("two ends", two_ends());
     let mode = |freq_hz: f64, gains: Vec<f64>| Mode {
         freq_hz,
         decay_per_s,
@@ -501,34 +489,42 @@ fn a_strike_on_modes_the_budget_switched_off_plays_the_strongest_at_once() {
     }
 }
 
+/// The frequencies of the strong modes the budget tests put at end a.
+const STRONG_HZ: [f64; 3] = [200.0, 230.0, 260.0];
+
+/// An engine on `bank` under a budget of eight modes, with or without `pruning`, struck on its
+/// root at end a and rung for `seconds`. Returns it with its controls (the strike point moved to
+/// end b), the root and the modes at [`STRONG_HZ`].
+fn struck_at_a(bank: &Bank, pruning: bool, seconds: f64) -> (Engine, Controls, u8, Vec<usize>) {
+    let mut e = pruned_engine(bank);
+    let strong = STRONG_HZ.iter().map(|&f| mode_at(&e, f)).collect();
+    let mut c = e.controls().clone();
+    c.pruning = pruning;
+    c.mode_budget = 8;
+    c.strike_x = 0.0;
+    e.set_controls(&c);
+    let key = root(&e);
+    render(&mut e, &[on(0, key, 1.0)], seconds, 64);
+    c.strike_x = 1.0;
+    e.set_controls(&c);
+    (e, c, key, strong)
+}
+
 #[test]
 fn modes_a_strike_wakes_under_a_budget_do_not_push_out_stronger_ones() {
     // Three strong modes and a group of weaker ones at end a, a group at end b.
-    let mut first: Vec<(f64, f64)> = vec![(200.0, 1.0), (230.0, 1.0), (260.0, 1.0)];
+    let mut first: Vec<(f64, f64)> = STRONG_HZ.iter().map(|&f| (f, 1.0)).collect();
     first.extend((0..20).map(|k| (400.0 * 1.15f64.powi(k), 0.3 * 0.7f64.powi(k))));
     let second: Vec<(f64, f64)> = (0..20)
         .map(|k| (430.0 * 1.15f64.powi(k), 0.6 * 0.7f64.powi(k)))
         .collect();
     let bank = two_ends_bank(&first, &second, 0.01, 2.0);
     for pruning in [false, true] {
-        let mut e = pruned_engine(&bank);
-        let strong: Vec<usize> = [200.0, 230.0, 260.0]
-            .iter()
-            .map(|&f| mode_at(&e, f))
-            .collect();
-        let mut c = e.controls().clone();
-        c.pruning = pruning;
-        c.mode_budget = 8;
-        c.strike_x = 0.0;
-        e.set_controls(&c);
-        let key = root(&e);
         // Struck at a, the budget keeps the strong modes and a's strongest after them.
-        render(&mut e, &[on(0, key, 1.0)], 0.2, 64);
+        let (mut e, _, key, strong) = struck_at_a(&bank, pruning, 0.2);
         let woken = e.pruning_stats().woken;
         // Struck at b: b's strongest outrank a's weaker ones and wake, as many as fit beside
         // the strong ones, which stay.
-        c.strike_x = 1.0;
-        e.set_controls(&c);
         render(&mut e, &[on(0, key, 1.0)], 0.02, 64);
         let woken = e.pruning_stats().woken - woken;
         assert!(
@@ -554,27 +550,14 @@ fn modes_that_cannot_be_switched_take_no_place_from_stronger_ones() {
     // mallet still in contact at the next control ticks: until it lets go, that voice's modes
     // cannot be switched. They must not push the strong ones out, whether they start from rest
     // or the budget had switched most of them off.
-    let first: Vec<(f64, f64)> = vec![(200.0, 1.0), (230.0, 1.0), (260.0, 1.0)];
+    let first: Vec<(f64, f64)> = STRONG_HZ.iter().map(|&f| (f, 1.0)).collect();
     let second: Vec<(f64, f64)> = (0..30)
         .map(|k| (430.0 * 1.1f64.powi(k), 0.1 * 0.95f64.powi(k)))
         .collect();
     let bank = two_ends_bank(&first, &second, 0.0, 2.0);
     for pruning in [false, true] {
         for dormant_first in [false, true] {
-            let mut e = pruned_engine(&bank);
-            let strong: Vec<usize> = [200.0, 230.0, 260.0]
-                .iter()
-                .map(|&f| mode_at(&e, f))
-                .collect();
-            let mut c = e.controls().clone();
-            c.pruning = pruning;
-            c.mode_budget = 8;
-            c.strike_x = 0.0;
-            e.set_controls(&c);
-            let key = root(&e);
-            render(&mut e, &[on(0, key, 1.0)], 0.05, 64);
-            c.strike_x = 1.0;
-            e.set_controls(&c);
+            let (mut e, mut c, key, strong) = struck_at_a(&bank, pruning, 0.05);
             if dormant_first {
                 // A short strike first: the budget switches most of b's modes off.
                 render(&mut e, &[on(0, key + 1, 1.0)], 0.05, 64);

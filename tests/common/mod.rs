@@ -29,6 +29,21 @@ pub fn simple_bank(modes: &[(f64, f64, f64)]) -> Bank {
     bank
 }
 
+/// Two strike positions on a line: `a` at 0 and `b` at 1.
+#[allow(dead_code)] // not every test file uses it
+pub fn two_ends() -> Vec<Position> {
+    vec![
+        Position {
+            name: "a".into(),
+            coords: vec![0.0],
+        },
+        Position {
+            name: "b".into(),
+            coords: vec![1.0],
+        },
+    ]
+}
+
 /// A bank of `n` inharmonic modes from `f0` with two positions, deterministic.
 pub fn dense_bank(n: usize, f0: f64) -> Bank {
     let positions = vec![
