@@ -16,8 +16,8 @@
 //!
 //! A strike decides at once which of its voice's dormant modes it makes audible ([`strike`]):
 //! those are woken at its exact sample and take it computed (under a budget, as many as the
-//! budget would keep); the others take it analytically and stay dormant. Audio input, which is not known in advance, wakes every dormant mode of the input
-//! voice.
+//! budget would keep); the others take it analytically and stay dormant. Audio input, which is
+//! not known in advance, wakes every dormant mode of the input voice.
 //!
 //! Most frames look only at what may have changed. Every level falls linearly in dB, so it is
 //! known how long each verdict holds: a heard mode cannot sink under today's masking envelope or
