@@ -199,15 +199,25 @@ pub fn session(
     })
 }
 
-/// Renders `script` on an audio thread of its own. When the script has a swap, the audio thread
-/// waits between blocks at its sample while `load` runs on this (the main) thread, as a host
-/// loading a state while it plays.
+/// What the host's main thread is asked to do while the audio thread plays.
+#[derive(Clone, Copy)]
+enum MainThread {
+    /// Load the script's swapped state now.
+    LoadSwap,
+    /// Run the plugin's main-thread callback if it asked for one.
+    Serve,
+}
+
+/// Renders `script` on an audio thread of its own while `main_thread` serves the plugin's
+/// callback requests on this (the main) thread, as a host does. When the script has a swap, the
+/// audio thread waits between blocks at its sample while the state loads here, as a host loading
+/// a state while it plays.
 #[allow(clippy::too_many_arguments)] // test plumbing: every output has its own place
 fn render_span(
     script: &Script,
     processor: StoppedPluginAudioProcessor<Host>,
     span: std::ops::Range<usize>,
-    load: &mut dyn FnMut(),
+    main_thread: &mut dyn FnMut(MainThread),
     left: &mut Vec<f32>,
     right: &mut Vec<f32>,
     statuses: &mut Vec<ProcessStatus>,
@@ -342,12 +352,21 @@ fn render_span(
             }
             p.stop_processing()
         });
-        if script.swap.is_some() {
-            while !reached.load(Ordering::SeqCst) && !audio.is_finished() {
-                std::thread::sleep(Duration::from_millis(1));
+        // The main thread, as a host's: it serves the plugin's callback requests while the
+        // audio thread plays, and loads the swapped state when the audio reaches it.
+        let mut swapped = script.swap.is_none();
+        loop {
+            let finished = audio.is_finished();
+            if !swapped && (finished || reached.load(Ordering::SeqCst)) {
+                main_thread(MainThread::LoadSwap);
+                loaded.store(true, Ordering::SeqCst);
+                swapped = true;
             }
-            load();
-            loaded.store(true, Ordering::SeqCst);
+            main_thread(MainThread::Serve);
+            if finished {
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(1));
         }
         audio.join().unwrap()
     })
@@ -424,19 +443,30 @@ pub fn run(script: &Script) -> Session {
     let mut statuses = Vec::new();
     let mut process_time = Duration::ZERO;
     let mut note_ends = Vec::new();
-    let handle = instance.plugin_handle();
-    let mut load = || {
-        if let Some((_, bytes)) = script.swap {
-            state_ext
-                .load(&handle, &mut std::io::Cursor::new(bytes.to_vec()))
-                .expect("state loads");
+    let mut main_thread = |call: MainThread| match call {
+        MainThread::LoadSwap => {
+            if let Some((_, bytes)) = script.swap {
+                state_ext
+                    .load(
+                        &instance.plugin_handle(),
+                        &mut std::io::Cursor::new(bytes.to_vec()),
+                    )
+                    .expect("state loads");
+            }
+        }
+        MainThread::Serve => {
+            if instance
+                .access_shared_handler(|h| h.callback_requested.swap(false, Ordering::SeqCst))
+            {
+                instance.call_on_main_thread_callback();
+            }
         }
     };
     processor = render_span(
         script,
         processor,
         0..script.samples,
-        &mut load,
+        &mut main_thread,
         &mut left,
         &mut right,
         &mut statuses,
