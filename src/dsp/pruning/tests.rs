@@ -186,3 +186,63 @@ fn a_masked_mode_names_the_loudest_masker_whose_curve_covers_it() {
         );
     }
 }
+
+/// The portable pass, and the AVX2 one where the CPU has it.
+fn both_paths(capacity: usize) -> Vec<MaskingPass> {
+    let mut portable = MaskingPass::with_capacity(capacity);
+    portable.avx2 = false;
+    let native = MaskingPass::with_capacity(capacity);
+    let mut passes = vec![portable];
+    if native.avx2 {
+        passes.push(native);
+    }
+    passes
+}
+
+#[test]
+fn maskers_of_an_earlier_pass_mask_nothing_in_the_next() {
+    // Eight 90 dB maskers, 2 Bark apart from 1 to 15 Bark, fill a whole group of lanes.
+    let loud_bark: Vec<f32> = (0..8).map(|k| 1.0 + 2.0 * k as f32).collect();
+    // Then a 70 dB mode at 22 Bark and a 40 dB one at 5.2 Bark, which the old masker at 5 Bark
+    // would cover (85 - 4 * 0.2 dB) and the new one does not (it is 16.8 Bark above it).
+    let (level, bark) = ([70.0, 40.0], [22.0, 5.2]);
+    for mut pass in both_paths(16) {
+        let mut v = vec![Verdict::Inaudible; 8];
+        pass.run(&[90.0; 8], &loud_bark, &[3.0; 8], 5.0, &mut v);
+        assert_eq!(pass.num_maskers(), 8, "{v:?}");
+        let mut v = [Verdict::Inaudible; 2];
+        pass.run(&level, &bark, &[3.0; 2], 5.0, &mut v);
+        assert_eq!(
+            v,
+            [Verdict::Audible { masker: true }; 2],
+            "avx2 {}",
+            pass.avx2
+        );
+    }
+}
+
+#[test]
+fn a_masker_or_a_mode_that_is_not_a_number_changes_no_other_verdict() {
+    // The neighbours of `a_loud_mode_masks_a_quiet_neighbour_and_not_a_distant_one`, with prior
+    // maskers of no level and of no critical-band rate, and a candidate of no level.
+    let level = [70.0, 40.0, 40.0, f32::NAN];
+    let bark = [10.0, 10.5, 16.0, 16.1];
+    for mut pass in both_paths(8) {
+        let mut v = [Verdict::Inaudible; 4];
+        pass.run_after(
+            &[16.0, f32::NAN],
+            &[f32::NAN, 90.0],
+            &level,
+            &bark,
+            &[3.0; 4],
+            5.0,
+            &mut v,
+            None,
+        );
+        let avx2 = pass.avx2;
+        assert_eq!(v[0], Verdict::Audible { masker: true }, "avx2 {avx2}");
+        assert_eq!(v[1], Verdict::Masked { by: 0 }, "avx2 {avx2}");
+        assert!(v[2].is_audible(), "avx2 {avx2}: {:?}", v[2]);
+        assert_eq!(v[3], Verdict::Inaudible, "avx2 {avx2}");
+    }
+}
