@@ -579,3 +579,36 @@ fn modes_that_cannot_be_switched_take_no_place_from_stronger_ones() {
         }
     }
 }
+
+#[test]
+fn a_masked_mode_fading_out_takes_no_place_under_the_budget() {
+    // A 62 Hz mode 6 dB under a 55 Hz one is masked: it fades out over two of its periods
+    // (32 ms), past the next analysis frame. Seven quiet modes far above fill the budget of eight
+    // with the loud one. Leaving, the masked mode must not push the quietest of them out.
+    let mut modes = vec![(55.0, 1.0, 1.0), (62.0, 1.0, 0.5)];
+    let quiet_hz = [
+        2_000.0, 2_600.0, 3_300.0, 4_100.0, 5_000.0, 6_000.0, 7_000.0,
+    ];
+    modes.extend(quiet_hz.iter().map(|&f| (f, 1.0, 0.05)));
+    let mut bank = simple_bank(&modes);
+    bank.root_hz = Some(55.0);
+    let mut e = pruned_engine(&bank);
+    let mut c = e.controls().clone();
+    c.mode_budget = 8;
+    e.set_controls(&c);
+    let masked = mode_at(&e, 62.0);
+    let quiet: Vec<usize> = quiet_hz.iter().map(|&f| mode_at(&e, f)).collect();
+    // Past the analysis at 20 ms (the masked mode still fading) and the 5 ms fade a mode switched
+    // off there would take.
+    strike(&mut e, 0.03);
+    let off = switched_off(&e);
+    assert!(!off.contains(&masked), "still fading: {off:?}");
+    assert!(
+        quiet.iter().all(|m| !off.contains(m)),
+        "quiet modes {quiet:?} switched off: {off:?}"
+    );
+    // Once it has faded out, the masked one is off and the others all play.
+    run(&mut e, 0.03);
+    let off = switched_off(&e);
+    assert_eq!(off, vec![masked]);
+}

@@ -18,6 +18,8 @@ pub struct ActiveMode {
     pub gain: f32,
     /// Whether it is fading in or out, or has a ghost fading in: it is not to be switched now.
     pub fading: bool,
+    /// Whether it is fading out: switched off, on its way to being carried analytically.
+    pub leaving: bool,
 }
 
 /// A dormant mode, as the pruner sees it.
@@ -99,6 +101,7 @@ impl ResonatorBank {
                     delta,
                     gain: self.gain[slot],
                     fading: fade != 0.0 || ghost.is_some(),
+                    leaving: fade > 0.0,
                 });
             }
         }

@@ -3,7 +3,9 @@
 
 use std::time::Instant;
 
-use super::candidates::{Reading, DORMANT, DRIVEN, DROP, LOCKED, OVER_BUDGET, UNSURE_MASKER};
+use super::candidates::{
+    Reading, DORMANT, DRIVEN, DROP, LEAVING, LOCKED, OVER_BUDGET, UNSURE_MASKER,
+};
 use super::{fade_samples, frame_samples, samples_to_cross, VoiceWatch};
 use super::{DORMANT_FULL_S, FULL_EVERY, GENERATION_MASK, NO_TAG};
 use crate::dsp::coeffs::gain_to_db;
@@ -116,7 +118,9 @@ impl Engine {
                 } else {
                     m.power
                 };
-                let flags = if locked { LOCKED } else { 0 } | if driven { DRIVEN } else { 0 };
+                let flags = if locked { LOCKED } else { 0 }
+                    | if driven { DRIVEN } else { 0 }
+                    | if m.leaving { LEAVING } else { 0 };
                 cands.push(
                     vi,
                     generation,
@@ -178,13 +182,14 @@ impl Engine {
         // The budget: keep the `cap` most energetic of what is audible. A mode that cannot be
         // switched now (fading, or in a voice being driven) stays computed wherever it ranks,
         // but takes no place from a stronger one: it runs over the cap until it can be switched.
+        // One fading out, or not heard, will be switched off when it can: it takes no place.
         if let Some(cap) = cap {
             p.ranked.clear();
             for i in 0..n {
                 let f = cd.flags[i];
                 // A dormant mode waiting for its voice's drive to end is not computed.
                 let waiting = f & (DORMANT | LOCKED) == DORMANT | LOCKED;
-                if waiting || f & DROP != 0 || !(cd.verdicts[i].is_audible() || f & LOCKED != 0) {
+                if waiting || f & (DROP | LEAVING) != 0 || !cd.verdicts[i].is_audible() {
                     continue;
                 }
                 p.ranked.push((cd.energy_db[i], i as u32));

@@ -17,6 +17,8 @@ pub(super) const OVER_BUDGET: u8 = 8;
 /// Candidate flag: its level includes a bound on what a strike under way adds, so as a masker
 /// it may be louder than it will be.
 pub(super) const DRIVEN: u8 = 16;
+/// Candidate flag: fading out, switched off already (it takes no place in the budget).
+pub(super) const LEAVING: u8 = 32;
 /// Flags of a masker not to be relied on past this analysis (its curve may be too high).
 pub(super) const UNSURE_MASKER: u8 = OVER_BUDGET | DRIVEN;
 
