@@ -184,7 +184,10 @@ impl MaskingPass {
         let mut loudest_prior = f32::NEG_INFINITY;
         for (j, (&b, &l)) in prior_bark.iter().zip(prior_level_db).enumerate() {
             self.push_masker(PRIOR as usize | j, b, l, offset_db);
-            loudest_prior = loudest_prior.max(l);
+            // A masker nowhere on the Bark scale masks nothing, and outranks nothing either.
+            if b.is_finite() {
+                loudest_prior = loudest_prior.max(l);
+            }
         }
         // Step 5: sort by level, loudest first.
         self.sort(level_db);

@@ -244,5 +244,20 @@ fn a_masker_or_a_mode_that_is_not_a_number_changes_no_other_verdict() {
         assert_eq!(v[1], Verdict::Masked { by: 0 }, "avx2 {avx2}");
         assert!(v[2].is_audible(), "avx2 {avx2}: {:?}", v[2]);
         assert_eq!(v[3], Verdict::Inaudible, "avx2 {avx2}");
+        // Nor does a prior masker of no critical-band rate take the loudest candidate's place:
+        // a quiet loudest mode is still kept, as the loudest of what sounds.
+        let mut v = [Verdict::Inaudible; 1];
+        let args = (&[5.0], &[10.0], &[3.0]);
+        pass.run_after(
+            &[f32::NAN],
+            &[90.0],
+            args.0,
+            args.1,
+            args.2,
+            5.0,
+            &mut v,
+            None,
+        );
+        assert_eq!(v[0], Verdict::Audible { masker: true }, "avx2 {avx2}");
     }
 }
