@@ -182,7 +182,8 @@ impl Engine {
         // The budget: keep the `cap` most energetic of what is audible. A mode that cannot be
         // switched now (fading, or in a voice being driven) stays computed wherever it ranks,
         // but takes no place from a stronger one: it runs over the cap until it can be switched.
-        // One fading out, or not heard, will be switched off when it can: it takes no place.
+        // One already fading out takes no place, nor does one not heard (switched off when it
+        // can be, if still unheard).
         if let Some(cap) = cap {
             p.ranked.clear();
             for i in 0..n {

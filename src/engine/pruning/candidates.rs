@@ -19,8 +19,9 @@ pub(super) const OVER_BUDGET: u8 = 8;
 pub(super) const DRIVEN: u8 = 16;
 /// Candidate flag: fading out, switched off already (it takes no place in the budget).
 pub(super) const LEAVING: u8 = 32;
-/// Flags of a masker not to be relied on past this analysis (its curve may be too high).
-pub(super) const UNSURE_MASKER: u8 = OVER_BUDGET | DRIVEN;
+/// Flags of a masker not to be relied on past this analysis (its curve may be too high, or it
+/// is about to fall silent).
+pub(super) const UNSURE_MASKER: u8 = OVER_BUDGET | DRIVEN | LEAVING;
 
 /// The mode in a `voice << 24 | mode` pair.
 pub(super) const MODE_MASK: u32 = 0x00ff_ffff;
