@@ -259,7 +259,8 @@ impl Engine {
                 m.len += 1;
             }
             for &j in p.pass.maskers() {
-                // Maskers silenced by the budget or lifted by a strike's bound are not carried.
+                // Maskers silenced by the budget, lifted by a strike's bound or fading out are not
+                // carried.
                 if j & PRIOR == 0 && cd.flags[j as usize] & UNSURE_MASKER == 0 {
                     let i = j as usize;
                     let voice = (cd.who[i] >> 24) as usize;

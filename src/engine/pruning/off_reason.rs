@@ -52,8 +52,8 @@ impl Pruner {
                     cd.fall_db[i],
                 );
                 let delay = (delay.clamp(0.0, 1e15) as u64).min(to_truncation);
-                // A masker silenced by the budget, or whose level holds a strike's bound, may
-                // not mask as long as its curve says: look again at the next analysis.
+                // A masker silenced by the budget, fading out, or whose level holds a strike's
+                // bound, may not mask as long as its curve says: look again at the next analysis.
                 let unsure = by & PRIOR == 0 && cd.flags[by as usize] & UNSURE_MASKER != 0;
                 let delay = if unsure { 0 } else { delay };
                 let reason = OffReason {

@@ -11,8 +11,8 @@
 //! beside them. A noise burst is not known in advance: it wakes them all.
 //!
 //! Under a budget, only as many are woken as the budget would keep, ranked by energy with the
-//! modes computed now and not fading out; the next control tick ranks everything again. With the budget alone the
-//! modes judged are those the strike lifts as far as it would start a silent one.
+//! modes computed now and not fading out; the next control tick ranks everything again. With the
+//! budget alone the modes judged are those the strike lifts as far as it would start a silent one.
 
 use std::time::Instant;
 
@@ -126,9 +126,9 @@ impl Engine {
 
     /// Sorts the lifted modes in `pruner.ranked` (energy, and what they are) by energy and
     /// returns how many of the first rank within the budget `cap` among them and every mode
-    /// computed now and not fading out (at its level with the strikes under way added), as the
-    /// next ranking will rank them. The modes woken go on at once; the next control tick ranks
-    /// everything again.
+    /// computed now and not fading out (at its level with the strikes under way added): at most
+    /// as many as the next ranking keeps, which leaves out computed modes not heard too. The
+    /// modes woken go on at once; the next control tick ranks everything again.
     fn best_within_budget(&mut self, cap: usize) -> usize {
         let Engine {
             pruner: p,
