@@ -247,13 +247,14 @@ fn a_masker_or_a_mode_that_is_not_a_number_changes_no_other_verdict() {
         // Nor does a prior masker of no critical-band rate take the loudest candidate's place:
         // the loudest mode is kept even below the threshold of hearing.
         let mut v = [Verdict::Inaudible; 1];
-        let args = (&[1.0], &[10.0], &[3.0]);
+        let (prior_bark, prior_level) = ([f32::NAN], [90.0]);
+        let (quiet_level, quiet_bark, threshold) = ([1.0], [10.0], [3.0]);
         pass.run_after(
-            &[f32::NAN],
-            &[90.0],
-            args.0,
-            args.1,
-            args.2,
+            &prior_bark,
+            &prior_level,
+            &quiet_level,
+            &quiet_bark,
+            &threshold,
             5.0,
             &mut v,
             None,
