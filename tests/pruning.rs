@@ -583,7 +583,7 @@ fn modes_that_cannot_be_switched_take_no_place_from_stronger_ones() {
 #[test]
 fn a_masked_mode_fading_out_takes_no_place_under_the_budget() {
     // A 62 Hz mode 6 dB under a 55 Hz one is masked: it fades out over two of its periods
-    // (32 ms), past the next analysis frame. Seven quiet modes far above fill the budget of eight
+    // (33 ms in whole control periods), past the next analysis frame. Seven quiet modes far above fill the budget of eight
     // with the loud one. Leaving, the masked mode must not push the quietest of them out.
     let mut modes = vec![(55.0, 1.0, 1.0), (62.0, 1.0, 0.5)];
     let quiet_hz = [

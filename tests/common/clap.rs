@@ -473,9 +473,6 @@ pub fn run(script: &Script) -> Session {
         &mut process_time,
         &mut note_ends,
     );
-    if instance.access_shared_handler(|h| h.callback_requested.swap(false, Ordering::SeqCst)) {
-        instance.call_on_main_thread_callback();
-    }
     let mut saved = Vec::new();
     state_ext
         .save(&instance.plugin_handle(), &mut saved)
