@@ -12,9 +12,9 @@
 //! and the unpruned one relative to the unpruned signal, per critical band.
 //!
 //! Run with `cargo bench --bench pruning`. Settings for experiments, from the environment:
-//! `PRUNING_REPEATS` (timed renders per case, default 3, the fastest counts),
-//! `PRUNING_OFFSETS=2.5,5,20` (other masking offsets; the targets are read at 5 dB),
-//! `PRUNING_FRAME_MS` (another analysis frame) and `PRUNING_ONLY=5` (pruned renders only,
+//! `PRUNING_REPEATS` (timed renders per case, default 5, the cases taking turns; the fastest of
+//! each counts), `PRUNING_OFFSETS=2.5,5,20` (other masking offsets; the targets are read at
+//! 5 dB), `PRUNING_FRAME_MS` (another analysis frame) and `PRUNING_ONLY=5` (pruned renders only,
 //! `PRUNING_REPEATS` of them, with every counter of the last, for profilers).
 
 use std::hint::black_box;
@@ -38,7 +38,7 @@ pub const RATE_HZ: f64 = 48_000.0;
 /// Longest block handed to the engine (blocks are also cut at every impact).
 const BLOCK: usize = 256;
 /// Timed renders per case; the fastest counts (the machine is shared).
-const REPEATS: usize = 3;
+const REPEATS: usize = 5;
 
 /// Timed renders per case: `PRUNING_REPEATS`, else [`REPEATS`].
 fn repeats() -> usize {
@@ -166,22 +166,33 @@ fn render(
     }
 }
 
-/// The fastest of `REPEATS` timed renders, with the meters of an untimed one.
-fn measure(prepared: &Arc<PreparedBank>, impacts: &[Impact], seconds: f64, c: &Controls) -> Run {
-    let mut run = render(prepared, impacts, seconds, c, true);
-    let mut best: Option<Run> = None;
+/// For each case's controls, the meters of an untimed render and the fastest of `repeats()` timed
+/// ones. The cases take turns, so that a busy spell on a shared machine slows them alike.
+fn measure(
+    prepared: &Arc<PreparedBank>,
+    impacts: &[Impact],
+    seconds: f64,
+    cases: &[Controls],
+) -> Vec<Run> {
+    let mut runs: Vec<Run> = cases
+        .iter()
+        .map(|c| render(prepared, impacts, seconds, c, true))
+        .collect();
+    // Wall, analysis and wake seconds of each case's fastest render.
+    let mut best: Vec<Option<(f64, f64, f64)>> = vec![None; cases.len()];
     for _ in 0..repeats() {
-        let r = render(prepared, impacts, seconds, c, false);
-        assert!(r.left == run.left, "renders of the same scene differ");
-        if best.as_ref().is_none_or(|b| r.wall_s < b.wall_s) {
-            best = Some(r);
+        for (k, c) in cases.iter().enumerate() {
+            let r = render(prepared, impacts, seconds, c, false);
+            assert!(r.left == runs[k].left, "renders of the same scene differ");
+            if best[k].is_none_or(|(wall_s, _, _)| r.wall_s < wall_s) {
+                best[k] = Some((r.wall_s, r.analysis_s, r.wake_s));
+            }
         }
     }
-    let best = best.expect("at least one repeat");
-    run.wall_s = best.wall_s;
-    run.analysis_s = best.analysis_s;
-    run.wake_s = best.wake_s;
-    run
+    for (run, best) in runs.iter_mut().zip(best) {
+        (run.wall_s, run.analysis_s, run.wake_s) = best.expect("at least one repeat");
+    }
+    runs
 }
 
 fn main() {
@@ -253,17 +264,11 @@ fn main() {
         .unwrap_or_else(|| vec![2.5, 5.0, 10.0]);
     let mut cases: Vec<(String, Option<f32>)> = vec![("off".into(), None)];
     cases.extend(offsets.iter().map(|&av| (format!("a_v {av} dB"), Some(av))));
-    let runs: Vec<Run> = cases
+    let case_controls: Vec<Controls> = cases
         .iter()
-        .map(|&(_, av)| {
-            measure(
-                &prepared,
-                &impacts,
-                seconds,
-                &controls(&bank, objects.len(), av),
-            )
-        })
+        .map(|&(_, av)| controls(&bank, objects.len(), av))
         .collect();
+    let runs = measure(&prepared, &impacts, seconds, &case_controls);
     let off = &runs[0];
     println!(
         "{:<11} {:>13} {:>7} {:>9} {:>7} {:>7} {:>9} {:>10} {:>10} {:>9} {:>10}",
