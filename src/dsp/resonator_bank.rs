@@ -61,6 +61,8 @@ pub struct ResonatorBank {
     ghost_of_mode: Vec<u32>,
     /// Number of slots in use in each column, ghosts included.
     live: [u32; COLUMNS],
+    /// Number of slots in use in all columns, ghosts included: the sum of `live`.
+    num_slots: usize,
     /// Number of modes belonging to each column, computed or dormant: new modes go to the
     /// emptiest, so a column never holds more than its share.
     claimed: [u32; COLUMNS],
@@ -130,6 +132,7 @@ impl ResonatorBank {
             slot_of_mode: vec![NONE; num_modes],
             ghost_of_mode: vec![NONE; num_modes],
             live: [0; COLUMNS],
+            num_slots: 0,
             claimed: [0; COLUMNS],
             rows_active: 0,
             num_started: 0,
@@ -168,7 +171,7 @@ impl ResonatorBank {
 
     /// Number of modes the kernels compute (fading ones included, ghosts not).
     pub fn num_active(&self) -> usize {
-        self.live.iter().map(|&n| n as usize).sum::<usize>() - self.num_ghosts
+        self.num_slots - self.num_ghosts
     }
 
     /// Number of modes the kernel advances per sample (live modes and ghosts plus padding).
@@ -230,6 +233,7 @@ impl ResonatorBank {
     fn push_slot(&mut self, entry: u32, column: usize) -> usize {
         let slot = self.live[column] as usize * COLUMNS + column;
         self.live[column] += 1;
+        self.num_slots += 1;
         self.clear_slot(slot);
         self.mode_of_slot[slot] = entry;
         let mode = (entry & !GHOST) as usize;
@@ -342,6 +346,7 @@ impl ResonatorBank {
             self.clear_slot(slot);
         }
         self.live = [0; COLUMNS];
+        self.num_slots = 0;
         self.claimed = [0; COLUMNS];
         self.rows_active = 0;
         self.num_started = 0;
@@ -398,6 +403,7 @@ impl ResonatorBank {
         }
         self.clear_slot(last);
         self.live[column] -= 1;
+        self.num_slots -= 1;
     }
 
     /// Zeroes a slot so the kernel computes silence there.
@@ -416,6 +422,10 @@ impl ResonatorBank {
 
     fn update_rows(&mut self) {
         let fullest = self.live.iter().copied().max().unwrap_or(0) as usize;
+        debug_assert_eq!(
+            self.num_slots,
+            self.live.iter().map(|&n| n as usize).sum::<usize>()
+        );
         self.rows_active = fullest.div_ceil(ROW_BLOCK) * ROW_BLOCK;
     }
 }

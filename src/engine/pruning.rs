@@ -315,7 +315,16 @@ fn fade_samples(theta: f32, sample_rate_hz: f64) -> u32 {
     let samples = (FADE_S * sample_rate_hz)
         .max(periods)
         .min(MAX_FADE_S * sample_rate_hz);
-    (samples / CONTROL_PERIOD as f64).ceil().max(1.0) as u32 * CONTROL_PERIOD as u32
+    // Rounded up by truncation and a compare (`f64::ceil` is a library call on x86-64 without
+    // SSE4.1); `samples` is positive and far below `u32::MAX` periods.
+    let blocks = samples / CONTROL_PERIOD as f64;
+    let whole = blocks as u32;
+    let whole = if (whole as f64) < blocks {
+        whole + 1
+    } else {
+        whole
+    };
+    whole.max(1) * CONTROL_PERIOD as u32
 }
 
 /// Samples (as a clock offset) a level `margin_db` above a line can fall at `fall_db` per sample

@@ -223,10 +223,10 @@ impl Engine {
                 p.stats.dropped += 1;
                 continue;
             }
-            let fade = fade_samples(p.cands.theta[i], rate);
+            let fade = || fade_samples(p.cands.theta[i], rate);
             if p.cands.verdicts[i].is_audible() && f & OVER_BUDGET == 0 {
                 if f & DORMANT != 0 {
-                    bank.switch_on(mode, fade);
+                    bank.switch_on(mode, fade());
                     p.stats.switched_on += 1;
                 } else {
                     // Heard until its margin over the envelope has decayed away.
@@ -243,7 +243,7 @@ impl Engine {
             if f & DORMANT != 0 {
                 bank.set_recheck(mode, recheck_at, tag);
             } else {
-                bank.switch_off(mode, fade, recheck_at, tag);
+                bank.switch_off(mode, fade(), recheck_at, tag);
                 p.stats.switched_off += 1;
                 engaged = true;
             }
