@@ -15,6 +15,7 @@
 //! sample. A mode woken by a strike computes the strike from rest at once, while its old ringing
 //! fades back in beside it in a *ghost* slot that ignores input, and joins it when the fade ends.
 
+mod absorb;
 mod dormant;
 mod fades;
 mod meters;
@@ -112,6 +113,8 @@ pub struct ResonatorBank {
     /// Strikes dormant modes took analytically whose pulses may still be playing: their start
     /// (bank clock) and shape.
     pulses: [(u64, Pulse); strike::MAX_PULSES],
+    /// Scratch for a strike taken by every dormant record at once.
+    absorb: absorb::AbsorbScratch,
     /// Number of `pulses` in use.
     num_pulses: usize,
 }
@@ -155,6 +158,7 @@ impl ResonatorBank {
             woken: 0,
             computed: 0,
             pulses: [(0, Pulse::NONE); strike::MAX_PULSES],
+            absorb: absorb::AbsorbScratch::new(num_modes),
             num_pulses: 0,
         }
     }

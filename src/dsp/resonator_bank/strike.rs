@@ -10,7 +10,6 @@
 
 use super::dormant::Dormant;
 use super::{ResonatorBank, NONE};
-use crate::dsp::masking::power_to_db;
 
 /// Most pulses kept track of at once (as many as one exciter overlaps).
 pub(super) const MAX_PULSES: usize = 4;
@@ -166,13 +165,16 @@ impl ResonatorBank {
         };
         let prepared = unit.prepared();
         let key = (pulse.shape, unit.samples());
+        // Each record is brought to now and its share of the pulse worked out; the arithmetic
+        // of the new states then runs over all of them at once.
+        let scratch = &mut self.absorb;
+        let mut n = 0;
         for r in 0..self.num_dormant {
             let d = &mut self.dormant[r];
             if self.slot_of_mode[d.mode as usize] != NONE {
                 continue;
             }
             d.advance_to(now);
-            let (re, im) = d.state();
             let gain = gain_of(d.mode as usize);
             let response = match d.response {
                 Some((shape, len, re, im)) if (shape, len) == key => C::new(re, im),
@@ -183,17 +185,27 @@ impl ResonatorBank {
                 }
             };
             let added = response.scale(pulse.amplitude as f64 * gain as f64);
-            let z = C::new(re as f64, im as f64).add(added);
-            let (re, im) = (z.re as f32, z.im as f32);
-            d.re = re;
-            d.im = im;
-            d.snap_db = power_to_db(re * re + im * im);
+            scratch.phase[n] = d.phase;
+            scratch.log_gain[n] = d.log_gain;
+            scratch.re[n] = d.re;
+            scratch.im[n] = d.im;
+            scratch.add_re[n] = added.re;
+            scratch.add_im[n] = added.im;
+            scratch.record[n] = r as u32;
+            n += 1;
             d.phase = 0.0;
             d.log_gain = 0.0;
             d.gain = gain;
             if due {
                 self.recheck[r] = now;
             }
+        }
+        scratch.run(n);
+        for k in 0..n {
+            let d = &mut self.dormant[scratch.record[k] as usize];
+            d.re = scratch.out_re[k];
+            d.im = scratch.out_im[k];
+            d.snap_db = scratch.out_db[k];
         }
         if due {
             self.earliest_recheck = self.earliest_recheck.min(now);
