@@ -164,6 +164,11 @@ pub(super) struct Pruner {
     off: Vec<OffReason>,
     /// Scratch: the dormant modes of a struck voice.
     dormant_scratch: Vec<DormantMode>,
+    /// Scratch for a strike: how far it lifts each masker of the struck voice's modes, in dB,
+    /// with the strike it was worked out for (`lift_stamp`).
+    lift_db: Vec<(u32, f32)>,
+    /// Counts the strikes judged, to tell `lift_db` entries of this one from stale ones.
+    lift_stamp: u32,
     /// Scratch: new recheck times `(mode, bank clock)` a strike sets.
     rechecks: Vec<(u32, u64)>,
     /// Number of `rechecks` in use.
@@ -207,6 +212,8 @@ impl Pruner {
             heard_until: Vec::new(),
             off: Vec::new(),
             dormant_scratch: Vec::new(),
+            lift_db: Vec::new(),
+            lift_stamp: 0,
             rechecks: Vec::new(),
             num_rechecks: 0,
             since_full: 0,
@@ -241,6 +248,8 @@ impl Pruner {
         self.off = vec![OffReason::UNKNOWN; n];
         self.rechecks = vec![(0, 0); num_modes];
         self.dormant_scratch = vec![DormantMode::default(); num_modes];
+        self.lift_db = vec![(0, 0.0); num_modes];
+        self.lift_stamp = 0;
         self.forget();
     }
 

@@ -205,6 +205,13 @@ impl Engine {
             num_dormant += 1;
         });
         p.num_rechecks = 0;
+        // A new stamp for this strike's lifts (every entry is stale after a wrap, as after
+        // `reserve`).
+        p.lift_stamp = p.lift_stamp.wrapping_add(1);
+        if p.lift_stamp == 0 {
+            p.lift_db.fill((0, 0.0));
+            p.lift_stamp = 1;
+        }
         for d in &p.dormant_scratch[..num_dormant] {
             // A mode off for the budget is judged like a lifted one (its reason names no
             // voice generation).
@@ -218,17 +225,25 @@ impl Engine {
             let level_db = d.level_db + calibration_db;
             // A masker in this voice takes the strike too: its curve rises with it (a masker
             // no longer computed is not known, and the mode is judged again).
+            // Worked out once per masker: many modes lie under the same few.
             let lift_db = if reason.masker == u32::MAX {
                 0.0
             } else {
                 let masker = reason.masker as usize;
-                match modes.state(masker) {
-                    Some((re, im)) => {
-                        let a = (re * re + im * im).sqrt();
-                        let lifted = a + gains[masker].abs() * bound;
-                        power_to_db(lifted * lifted) - power_to_db(a * a)
+                match p.lift_db[masker] {
+                    (stamp, lift) if stamp == p.lift_stamp => lift,
+                    _ => {
+                        let lift = match modes.state(masker) {
+                            Some((re, im)) => {
+                                let a = (re * re + im * im).sqrt();
+                                let lifted = a + gains[masker].abs() * bound;
+                                power_to_db(lifted * lifted) - power_to_db(a * a)
+                            }
+                            None => f32::NEG_INFINITY,
+                        };
+                        p.lift_db[masker] = (p.lift_stamp, lift);
+                        lift
                     }
-                    None => f32::NEG_INFINITY,
                 }
             };
             let to_beat = reason.level_to_beat(now) + lift_db;
