@@ -201,14 +201,15 @@ impl MaskingPass {
                 verdicts[i] = Verdict::Inaudible;
                 continue;
             }
-            // Step 7, against the envelope of every masker so far at once.
-            let envelope = self.envelope_at(b);
+            // Step 7, against the envelope of every masker so far at once (and the first
+            // masker above the mode, named if it is masked).
+            let (envelope, first_above) = self.envelope_at(b, l);
             if let Some(out) = envelope_db.as_deref_mut() {
                 out[i] = envelope.max(threshold_db[i]);
             }
             verdicts[i] = if l < envelope {
                 Verdict::Masked {
-                    by: self.masker_index[self.masker_above(b, l)],
+                    by: self.masker_index[first_above.unwrap_or(0)],
                 }
             } else if !loudest && l < envelope.max(threshold_db[i]) + offset_db {
                 // Close to a masker's curve, or to the threshold in quiet (the seed's curve
@@ -257,29 +258,25 @@ impl MaskingPass {
     }
 
     /// Upper envelope of the maskers' curves at `bark` (seed 001 eq. 4 without the threshold in
-    /// quiet, which the caller has already applied): every masker at once, eight lanes at a
-    /// time, with AVX2 when the CPU has it.
+    /// quiet, which the caller has already applied), and the first masker (loudest first) whose
+    /// curve there lies above `level_db`: every masker at once, eight lanes at a time, in one
+    /// pass with AVX2 when the CPU has it.
     #[inline]
-    fn envelope_at(&self, bark: f32) -> f32 {
+    fn envelope_at(&self, bark: f32, level_db: f32) -> (f32, Option<usize>) {
         let (mb, peak, su) = self.masker_lanes();
         #[cfg(target_arch = "x86_64")]
         if self.avx2 {
             // SAFETY: `avx2` is only set when the CPU supports AVX2 and FMA.
-            return unsafe { envelope_avx2(mb, peak, su, bark) };
+            return unsafe { envelope_and_first_above_avx2(mb, peak, su, bark, level_db) };
         }
-        envelope(mb, peak, su, bark)
-    }
-
-    /// The first masker (loudest first) whose curve at `bark` lies above `level_db`, eight lanes
-    /// at a time, with AVX2 when the CPU has it.
-    fn masker_above(&self, bark: f32, level_db: f32) -> usize {
-        let (mb, peak, su) = self.masker_lanes();
-        #[cfg(target_arch = "x86_64")]
-        if self.avx2 {
-            // SAFETY: `avx2` is only set when the CPU supports AVX2 and FMA.
-            return unsafe { first_above_avx2(mb, peak, su, bark, level_db) }.unwrap_or(0);
-        }
-        first_above(mb, peak, su, bark, level_db).unwrap_or(0)
+        let envelope = envelope(mb, peak, su, bark);
+        // Only a mode under the envelope has a masker above it.
+        let first = if level_db < envelope {
+            first_above(mb, peak, su, bark, level_db)
+        } else {
+            None
+        };
+        (envelope, first)
     }
 
     /// The maskers' bark, peak and upper slope, padded to a whole number of lanes.
@@ -322,14 +319,54 @@ fn envelope(masker_bark: &[f32], peak: &[f32], upper_slope: &[f32], bark: f32) -
     best.into_iter().fold(f32::NEG_INFINITY, f32::max)
 }
 
-/// [`envelope`] compiled for AVX2 and FMA.
+/// [`envelope`] and [`first_above`] in one pass, with AVX2 and FMA intrinsics: the same
+/// comparisons in the same order, so the same results.
 ///
 /// # Safety
 /// The CPU must support AVX2 and FMA.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn envelope_avx2(masker_bark: &[f32], peak: &[f32], upper_slope: &[f32], bark: f32) -> f32 {
-    envelope(masker_bark, peak, upper_slope, bark)
+unsafe fn envelope_and_first_above_avx2(
+    masker_bark: &[f32],
+    peak: &[f32],
+    upper_slope: &[f32],
+    bark: f32,
+    level_db: f32,
+) -> (f32, Option<usize>) {
+    use std::arch::x86_64::*;
+    const _: () = assert!(LANES == 8);
+    let n = masker_bark.len();
+    assert!(peak.len() == n && upper_slope.len() == n && n % LANES == 0);
+    let b = _mm256_set1_ps(bark);
+    let level = _mm256_set1_ps(level_db);
+    let lower = _mm256_set1_ps(LOWER_SLOPE_DB_PER_BARK);
+    let mut best = _mm256_set1_ps(f32::NEG_INFINITY);
+    let mut first = None;
+    for k in (0..n).step_by(LANES) {
+        // SAFETY: `k + LANES <= n`, the length of all three slices (checked above).
+        let (mb, pk, su) = unsafe {
+            (
+                _mm256_loadu_ps(masker_bark.as_ptr().add(k)),
+                _mm256_loadu_ps(peak.as_ptr().add(k)),
+                _mm256_loadu_ps(upper_slope.as_ptr().add(k)),
+            )
+        };
+        let below = _mm256_mul_ps(lower, _mm256_sub_ps(mb, b));
+        let above = _mm256_mul_ps(su, _mm256_sub_ps(b, mb));
+        // `max_ps(x, y)` is `if x > y { x } else { y }`, as in `envelope`.
+        let curve = _mm256_sub_ps(pk, _mm256_max_ps(below, above));
+        best = _mm256_max_ps(curve, best);
+        if first.is_none() {
+            let above_level = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_GT_OQ>(curve, level));
+            if above_level != 0 {
+                first = Some(k + above_level.trailing_zeros() as usize);
+            }
+        }
+    }
+    let mut lanes = [0.0f32; LANES];
+    // SAFETY: `lanes` holds eight floats.
+    unsafe { _mm256_storeu_ps(lanes.as_mut_ptr(), best) };
+    (lanes.into_iter().fold(f32::NEG_INFINITY, f32::max), first)
 }
 
 /// The first masker, given as parallel lanes as for [`envelope`], whose curve at `bark` lies above
@@ -360,22 +397,6 @@ fn first_above(
         }
     }
     None
-}
-
-/// [`first_above`] compiled for AVX2 and FMA.
-///
-/// # Safety
-/// The CPU must support AVX2 and FMA.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn first_above_avx2(
-    masker_bark: &[f32],
-    peak: &[f32],
-    upper_slope: &[f32],
-    bark: f32,
-    level_db: f32,
-) -> Option<usize> {
-    first_above(masker_bark, peak, upper_slope, bark, level_db)
 }
 
 /// Reorders `ranked` so that its first `keep` entries are those with the most energy (the first

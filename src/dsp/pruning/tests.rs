@@ -262,3 +262,60 @@ fn a_masker_or_a_mode_that_is_not_a_number_changes_no_other_verdict() {
         assert_eq!(v[0], Verdict::Audible { masker: true }, "avx2 {avx2}");
     }
 }
+
+#[test]
+fn both_paths_give_the_same_verdicts_maskers_and_envelopes() {
+    // Three hundred modes spread over the Bark scale at scattered levels, after forty prior
+    // maskers: many maskers per lane group, so a masked mode's masker is often past the first.
+    let n = 300;
+    let mut seed = 0x2545_f491u32;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 17;
+        seed ^= seed << 5;
+        seed as f32 / u32::MAX as f32
+    };
+    let prior_bark: Vec<f32> = (0..40).map(|_| 24.0 * next()).collect();
+    let prior_level: Vec<f32> = (0..40).map(|_| 30.0 + 60.0 * next()).collect();
+    let bark: Vec<f32> = (0..n).map(|_| 24.0 * next()).collect();
+    let level: Vec<f32> = (0..n).map(|_| 100.0 * next()).collect();
+    let threshold = vec![10.0; n];
+    let mut results = Vec::new();
+    for mut pass in both_paths(n + 40) {
+        let mut v = vec![Verdict::Inaudible; n];
+        let mut envelope = vec![0.0; n];
+        pass.run_after(
+            &prior_bark,
+            &prior_level,
+            &level,
+            &bark,
+            &threshold,
+            5.0,
+            &mut v,
+            Some(&mut envelope),
+        );
+        let masked = v
+            .iter()
+            .filter(|x| matches!(x, Verdict::Masked { .. }))
+            .count();
+        assert!(masked > n / 4, "{masked} masked");
+        let by_later = v
+            .iter()
+            .filter(|x| matches!(x, Verdict::Masked { by } if by & !PRIOR >= 8))
+            .count();
+        assert!(by_later > 10, "{by_later} masked past the first lane group");
+        results.push((v, envelope));
+    }
+    if let [portable, native] = &results[..] {
+        assert_eq!(portable.0, native.0);
+        for i in 0..n {
+            if portable.0[i].is_audible() {
+                assert_eq!(
+                    portable.1[i].to_bits(),
+                    native.1[i].to_bits(),
+                    "envelope at {i}"
+                );
+            }
+        }
+    }
+}
