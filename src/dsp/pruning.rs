@@ -336,7 +336,7 @@ unsafe fn envelope_and_first_above_avx2(
     use std::arch::x86_64::*;
     const _: () = assert!(LANES == 8);
     let n = masker_bark.len();
-    assert!(peak.len() == n && upper_slope.len() == n && n % LANES == 0);
+    assert!(peak.len() == n && upper_slope.len() == n && n.is_multiple_of(LANES));
     let b = _mm256_set1_ps(bark);
     let level = _mm256_set1_ps(level_db);
     let lower = _mm256_set1_ps(LOWER_SLOPE_DB_PER_BARK);

@@ -306,16 +306,20 @@ fn both_paths_give_the_same_verdicts_maskers_and_envelopes() {
         assert!(by_later > 10, "{by_later} masked past the first lane group");
         results.push((v, envelope));
     }
-    if let [portable, native] = &results[..] {
-        assert_eq!(portable.0, native.0);
-        for i in 0..n {
-            if portable.0[i].is_audible() {
-                assert_eq!(
-                    portable.1[i].to_bits(),
-                    native.1[i].to_bits(),
-                    "envelope at {i}"
-                );
+    match &results[..] {
+        [portable, native] => {
+            assert_eq!(portable.0, native.0);
+            // The envelope is written for every mode above the threshold of hearing.
+            for i in 0..n {
+                if portable.0[i] != Verdict::Inaudible {
+                    assert_eq!(
+                        portable.1[i].to_bits(),
+                        native.1[i].to_bits(),
+                        "envelope at {i}"
+                    );
+                }
             }
         }
+        _ => eprintln!("no AVX2 on this CPU: only the portable path ran"),
     }
 }
