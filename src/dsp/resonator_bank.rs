@@ -25,6 +25,7 @@ mod strike;
 mod tests;
 mod views;
 
+pub(crate) use dormant::floor;
 pub use dormant::FADE_DEPTH_NEPERS;
 pub use strike::{Pulse, PulseShape};
 pub use views::{ActiveMode, DormantMode};

@@ -38,7 +38,7 @@ mod strike;
 use super::voice::{Tuning, Voice, VoiceState};
 use super::{Engine, CONTROL_PERIOD};
 use crate::dsp::pruning::MaskingPass;
-use crate::dsp::resonator_bank::DormantMode;
+use crate::dsp::resonator_bank::{floor, DormantMode};
 use candidates::Candidates;
 use maskers::Maskers;
 use off_reason::OffReason;
@@ -324,16 +324,9 @@ fn fade_samples(theta: f32, sample_rate_hz: f64) -> u32 {
     let samples = (FADE_S * sample_rate_hz)
         .max(periods)
         .min(MAX_FADE_S * sample_rate_hz);
-    // Rounded up by truncation and a compare (`f64::ceil` is a library call on x86-64 without
-    // SSE4.1); `samples` is positive and far below `u32::MAX` periods.
-    let blocks = samples / CONTROL_PERIOD as f64;
-    let whole = blocks as u32;
-    let whole = if (whole as f64) < blocks {
-        whole + 1
-    } else {
-        whole
-    };
-    whole.max(1) * CONTROL_PERIOD as u32
+    // Rounded up without `f64::ceil`, a library call on x86-64 without SSE4.1.
+    let blocks = -floor(-samples / CONTROL_PERIOD as f64);
+    blocks.max(1.0) as u32 * CONTROL_PERIOD as u32
 }
 
 /// Samples (as a clock offset) a level `margin_db` above a line can fall at `fall_db` per sample

@@ -132,7 +132,7 @@ impl Dormant {
 /// `x` rounded down, for `|x|` below `2^63`: a truncation and a compare, where `f64::floor` is a
 /// library call on x86-64 without SSE4.1.
 #[inline]
-fn floor(x: f64) -> f64 {
+pub(crate) fn floor(x: f64) -> f64 {
     let t = x as i64 as f64;
     if t > x {
         t - 1.0
