@@ -305,18 +305,16 @@ impl ResonatorBank {
     /// many modes stopped.
     pub fn retire_below(&mut self, threshold: f32) -> usize {
         let threshold_sq = threshold * threshold;
-        // Usually nothing is due: one pass the compiler vectorises finds out.
+        // Usually nothing is due: one pass over the states finds out. The slots past each
+        // column's live ones hold zeros, so they are at or below any threshold: when no more
+        // slots than those are, no live one is. (Fading modes and ghosts found here are passed
+        // over below.)
         let n = self.rows_active * COLUMNS;
-        let (re, im) = (&self.re[..n], &self.im[..n]);
-        let (entry, fade) = (&self.mode_of_slot[..n], &self.fade_delta[..n]);
-        let mut suspects = 0u32;
-        for i in 0..n {
-            let e = re[i] * re[i] + im[i] * im[i];
-            // Branch-free, so the pass vectorises; a state that is not a number is retired too.
-            suspects +=
-                below(e, threshold_sq) as u32 & (entry[i] != NONE) as u32 & (fade[i] == 0.0) as u32;
-        }
-        if suspects == 0 {
+        if count_not_above(&self.re[..n], &self.im[..n], threshold_sq) <= n - self.num_slots {
+            debug_assert!(self.live_slots().all(|slot| {
+                let e = self.re[slot] * self.re[slot] + self.im[slot] * self.im[slot];
+                !below(e, threshold_sq)
+            }));
             return 0;
         }
         let mut retired = 0;
@@ -437,6 +435,40 @@ impl ResonatorBank {
 
 /// Whether power `e` is under `threshold_sq`, or not a number (a state gone bad is retired too).
 #[inline]
+/// How many of the states `re + i im` have `|z|^2` not above `threshold_sq` (not-a-number
+/// counts).
+fn count_not_above(re: &[f32], im: &[f32], threshold_sq: f32) -> usize {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma") {
+            // SAFETY: the CPU supports AVX2 and FMA.
+            return unsafe { count_not_above_avx2(re, im, threshold_sq) };
+        }
+    }
+    count_not_above_portable(re, im, threshold_sq)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn count_not_above_avx2(re: &[f32], im: &[f32], threshold_sq: f32) -> usize {
+    count_not_above_portable(re, im, threshold_sq)
+}
+
+/// Branch-free over whole rows, so it vectorises. `!(e > t)` is meant: it holds when either is
+/// not a number.
+#[inline(always)]
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
+fn count_not_above_portable(re: &[f32], im: &[f32], threshold_sq: f32) -> usize {
+    let mut counts = [0u32; COLUMNS];
+    for (r, i) in re.chunks_exact(COLUMNS).zip(im.chunks_exact(COLUMNS)) {
+        for j in 0..COLUMNS {
+            let e = r[j] * r[j] + i[j] * i[j];
+            counts[j] += !(e > threshold_sq) as u32;
+        }
+    }
+    counts.iter().map(|&c| c as usize).sum()
+}
+
 fn below(e: f32, threshold_sq: f32) -> bool {
     !matches!(
         e.partial_cmp(&threshold_sq),

@@ -40,6 +40,31 @@ fn repacking_keeps_each_mode_with_its_state() {
 }
 
 #[test]
+fn retiring_finds_quiet_and_broken_modes_among_padding() {
+    // 20 modes: columns of three and two, so the rows the kernels run over hold 12 empty slots.
+    let mut bank = ResonatorBank::new(20);
+    for m in 0..20 {
+        bank.activate(m, coeffs(m), 1.0);
+    }
+    let mut acc = vec![[0.0; COLUMNS]; 16];
+    let input: Vec<f32> = (0..16).map(|n| if n == 0 { 1.0 } else { 0.0 }).collect();
+    bank.process(Kernel::Scalar, Some(&input), &mut acc);
+    assert_eq!(bank.rows_active * COLUMNS - bank.num_slots, 12);
+    // Nothing is below: nothing goes.
+    assert_eq!(bank.retire_below(1e-6), 0);
+    assert_eq!(bank.num_live(), 20);
+    // One quiet mode in a short column, one whose state is not a number in a long one.
+    for (m, value) in [(17, 1e-9), (8, f32::NAN)] {
+        let slot = bank.slot_of_mode[m] as usize;
+        bank.re[slot] = value;
+        bank.im[slot] = 0.0;
+    }
+    assert_eq!(bank.retire_below(1e-6), 2);
+    assert!(!bank.is_live(17) && !bank.is_live(8));
+    assert_eq!(bank.num_live(), 18);
+}
+
+#[test]
 fn skipped_modes_do_not_leave_lanes_empty() {
     // Only even modes sound, as when a string is struck at its middle.
     let mut bank = ResonatorBank::new(256);
