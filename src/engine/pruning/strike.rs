@@ -252,13 +252,19 @@ impl Engine {
                 let curve = reason.curve_db - reason.fall_db * (now - reason.at) as f32 + lift_db;
                 let fall = DB_PER_NEPER * d.delta as f32;
                 let closing = reason.fall_db - fall;
-                if curve > reason.threshold_db && closing > 0.0 {
-                    let delay = samples_to_cross(curve - level_db, closing);
-                    let recheck_at = d.recheck_at.min(bank_now + delay);
-                    if recheck_at != d.recheck_at {
-                        p.rechecks[p.num_rechecks] = (d.mode as u32, recheck_at);
-                        p.num_rechecks += 1;
-                    }
+                let recheck_at = if level_db >= to_beat - lift_db {
+                    // Off only under its masker's lift, a bound: the next analysis reads the
+                    // masker as it is.
+                    bank_now
+                } else if curve > reason.threshold_db && closing > 0.0 {
+                    bank_now + samples_to_cross(curve - level_db, closing)
+                } else {
+                    d.recheck_at
+                };
+                let recheck_at = d.recheck_at.min(recheck_at);
+                if recheck_at != d.recheck_at {
+                    p.rechecks[p.num_rechecks] = (d.mode as u32, recheck_at);
+                    p.num_rechecks += 1;
                 }
                 continue;
             }
