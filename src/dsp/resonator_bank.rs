@@ -310,11 +310,12 @@ impl ResonatorBank {
         // slots than those are, no live one is. (Fading modes and ghosts found here are passed
         // over below.)
         let n = self.rows_active * COLUMNS;
+        debug_assert!(
+            (0..n).all(|slot| slot / COLUMNS < self.live[slot % COLUMNS] as usize
+                || (self.re[slot], self.im[slot]) == (0.0, 0.0)),
+            "an empty slot holds a state"
+        );
         if count_not_above(&self.re[..n], &self.im[..n], threshold_sq) <= n - self.num_slots {
-            debug_assert!(self.live_slots().all(|slot| {
-                let e = self.re[slot] * self.re[slot] + self.im[slot] * self.im[slot];
-                !below(e, threshold_sq)
-            }));
             return 0;
         }
         let mut retired = 0;
@@ -433,8 +434,6 @@ impl ResonatorBank {
     }
 }
 
-/// Whether power `e` is under `threshold_sq`, or not a number (a state gone bad is retired too).
-#[inline]
 /// How many of the states `re + i im` have `|z|^2` not above `threshold_sq` (not-a-number
 /// counts).
 fn count_not_above(re: &[f32], im: &[f32], threshold_sq: f32) -> usize {
@@ -469,6 +468,8 @@ fn count_not_above_portable(re: &[f32], im: &[f32], threshold_sq: f32) -> usize 
     counts.iter().map(|&c| c as usize).sum()
 }
 
+/// Whether power `e` is under `threshold_sq`, or not a number (a state gone bad is retired too).
+#[inline]
 fn below(e: f32, threshold_sq: f32) -> bool {
     !matches!(
         e.partial_cmp(&threshold_sq),

@@ -248,7 +248,8 @@ impl Engine {
             };
             let to_beat = reason.level_to_beat(now) + lift_db;
             if reason.generation == generation && !stale_tag && level_db < to_beat {
-                // Still off: it surfaces no sooner than its margin under the curve allows.
+                // Still off. Under its masker's curve without the lift, it surfaces no sooner
+                // than its margin under the curve allows.
                 let curve = reason.curve_db - reason.fall_db * (now - reason.at) as f32 + lift_db;
                 let fall = DB_PER_NEPER * d.delta as f32;
                 let closing = reason.fall_db - fall;
