@@ -413,27 +413,36 @@ fn a_masked_mode_surfaces_on_time_after_a_strike_that_leaves_it_masked() {
 
 #[test]
 fn a_masked_mode_is_heard_at_once_when_a_strike_cancels_its_masker() {
-    // A loud 1 kHz mode masks a quieter 1060 Hz one by a few dB; both ring on alike, so on its
-    // own the quiet one would never surface. A second strike comes when the loud mode's phasor
-    // points against the impulse (half a period, 24 samples, after a whole number of periods)
-    // and at the force it has decayed to, so it nearly cancels, while the quiet mode, in phase
-    // there, doubles: it is heard now, and must be switched on at the next analysis.
+    // A loud 1 kHz mode masks a quieter 1060 Hz one, by a few dB or by more than the strike
+    // lifts it; both ring on alike, so on its own the quiet one would never surface. A second
+    // strike comes when the loud mode's phasor points against the impulse (half a period, 24
+    // samples, after a whole number of periods) and at the force it has decayed to, so it nearly
+    // cancels, while the quiet mode, in phase there, doubles: it is heard now, and must be
+    // switched on at the next analysis.
     const DECAY_PER_S: f64 = 1.0;
-    let bank = simple_bank(&[(1000.0, DECAY_PER_S, 1.0), (1060.0, DECAY_PER_S, 0.3)]);
-    let mut e = pruned_engine(&bank);
-    let mut c = e.controls().clone();
-    c.velocity_sensitivity = 0.5;
-    e.set_controls(&c);
-    let (key, quiet) = (root(&e), mode_at(&e, 1060.0));
-    let at = 83 * 24;
-    let seconds = at as f64 / RATE as f64;
-    let velocity = (-DECAY_PER_S * seconds).exp() as f32;
-    render(&mut e, &[on(0, key, 1.0)], seconds, 256);
-    assert_eq!(switched_off(&e), vec![quiet], "the quiet mode is masked");
-    let period = CONTROL_PERIOD as f64 / RATE as f64;
-    render(&mut e, &[on(0, key, velocity)], period, 256);
-    let heard = period + first_heard(&mut e, quiet, 1.5).expect("the quiet mode is heard");
-    assert!(heard < 0.05, "heard {heard:.3} s after the strike");
+    for quiet_gain in [0.3, 0.1] {
+        let bank = simple_bank(&[
+            (1000.0, DECAY_PER_S, 1.0),
+            (1060.0, DECAY_PER_S, quiet_gain),
+        ]);
+        let mut e = pruned_engine(&bank);
+        let mut c = e.controls().clone();
+        c.velocity_sensitivity = 0.5;
+        e.set_controls(&c);
+        let (key, quiet) = (root(&e), mode_at(&e, 1060.0));
+        let at = 83 * 24;
+        let seconds = at as f64 / RATE as f64;
+        let velocity = (-DECAY_PER_S * seconds).exp() as f32;
+        render(&mut e, &[on(0, key, 1.0)], seconds, 256);
+        assert_eq!(switched_off(&e), vec![quiet], "gain {quiet_gain}: masked");
+        let period = CONTROL_PERIOD as f64 / RATE as f64;
+        render(&mut e, &[on(0, key, velocity)], period, 256);
+        let heard = period + first_heard(&mut e, quiet, 1.5).expect("the quiet mode is heard");
+        assert!(
+            heard < 0.05,
+            "gain {quiet_gain}: heard {heard:.3} s after the strike"
+        );
+    }
 }
 
 /// Energy of `x` in dB.

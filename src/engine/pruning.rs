@@ -164,9 +164,10 @@ pub(super) struct Pruner {
     off: Vec<OffReason>,
     /// Scratch: the dormant modes of a struck voice.
     dormant_scratch: Vec<DormantMode>,
-    /// Scratch for a strike: how far it lifts each masker of the struck voice's modes, in dB,
-    /// with the strike it was worked out for (`lift_stamp`).
-    lift_db: Vec<(u32, f32)>,
+    /// Scratch for a strike: how far it can lift each masker of the struck voice's modes, at
+    /// most and at least (a fall, when the strike meets the masker's ringing out of phase), in
+    /// dB, after the strike it was worked out for (`lift_stamp`).
+    lift_db: Vec<(u32, f32, f32)>,
     /// Counts the strikes judged, to tell `lift_db` entries of this one from stale ones.
     lift_stamp: u32,
     /// Scratch: new recheck times `(mode, bank clock)` a strike sets.
@@ -248,7 +249,7 @@ impl Pruner {
         self.off = vec![OffReason::UNKNOWN; n];
         self.rechecks = vec![(0, 0); num_modes];
         self.dormant_scratch = vec![DormantMode::default(); num_modes];
-        self.lift_db = vec![(0, 0.0); num_modes];
+        self.lift_db = vec![(0, 0.0, 0.0); num_modes];
         self.lift_stamp = 0;
         self.forget();
     }

@@ -209,7 +209,7 @@ impl Engine {
         // `reserve`).
         p.lift_stamp = p.lift_stamp.wrapping_add(1);
         if p.lift_stamp == 0 {
-            p.lift_db.fill((0, 0.0));
+            p.lift_db.fill((0, 0.0, 0.0));
             p.lift_stamp = 1;
         }
         for d in &p.dormant_scratch[..num_dormant] {
@@ -223,39 +223,46 @@ impl Engine {
                     .is_none_or(|&g| g != d.tag & super::GENERATION_MASK)
             };
             let level_db = d.level_db + calibration_db;
-            // A masker in this voice takes the strike too: its curve rises with it (a masker
-            // no longer computed is not known, and the mode is judged again).
+            // A masker in this voice takes the strike too: its curve rises with it, by at most
+            // `lift_db` (in phase) and at least `least_lift_db` (out of phase, a fall). A masker
+            // no longer computed is not known, and the mode is judged again.
             // Worked out once per masker: many modes lie under the same few.
-            let lift_db = if reason.masker == u32::MAX {
-                0.0
+            let (lift_db, least_lift_db) = if reason.masker == u32::MAX {
+                (0.0, 0.0)
             } else {
                 let masker = reason.masker as usize;
                 match p.lift_db[masker] {
-                    (stamp, lift) if stamp == p.lift_stamp => lift,
+                    (stamp, lift, least) if stamp == p.lift_stamp => (lift, least),
                     _ => {
-                        let lift = match modes.state(masker) {
+                        let (lift, least) = match modes.state(masker) {
                             Some((re, im)) => {
                                 let a = (re * re + im * im).sqrt();
-                                let lifted = a + gains[masker].abs() * bound;
-                                power_to_db(lifted * lifted) - power_to_db(a * a)
+                                let pulse = gains[masker].abs() * bound;
+                                let (most, least) = (a + pulse, (a - pulse).max(0.0));
+                                let now_db = power_to_db(a * a);
+                                (
+                                    power_to_db(most * most) - now_db,
+                                    power_to_db(least * least) - now_db,
+                                )
                             }
-                            None => f32::NEG_INFINITY,
+                            None => (f32::NEG_INFINITY, f32::NEG_INFINITY),
                         };
-                        p.lift_db[masker] = (p.lift_stamp, lift);
-                        lift
+                        p.lift_db[masker] = (p.lift_stamp, lift, least);
+                        (lift, least)
                     }
                 }
             };
             let to_beat = reason.level_to_beat(now) + lift_db;
             if reason.generation == generation && !stale_tag && level_db < to_beat {
-                // Still off. Under its masker's curve without the lift, it surfaces no sooner
+                // Still off. Under the lowest curve the strike can leave, it surfaces no sooner
                 // than its margin under the curve allows.
                 let curve = reason.curve_db - reason.fall_db * (now - reason.at) as f32 + lift_db;
                 let fall = DB_PER_NEPER * d.delta as f32;
                 let closing = reason.fall_db - fall;
-                let recheck_at = if level_db >= to_beat - lift_db {
-                    // Off only under its masker's lift, a bound: the next analysis reads the
-                    // masker as it is.
+                let lowest = (curve - lift_db + least_lift_db).max(reason.threshold_db);
+                let recheck_at = if level_db >= lowest {
+                    // Off only if its masker takes the strike well enough in phase: the next
+                    // analysis reads the masker as it is.
                     bank_now
                 } else if curve > reason.threshold_db && closing > 0.0 {
                     bank_now + samples_to_cross(curve - level_db, closing)
