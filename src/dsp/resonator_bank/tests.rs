@@ -62,7 +62,7 @@ fn retiring_finds_quiet_and_broken_modes_among_padding() {
     set(&mut bank, 8, f32::NAN);
     assert_eq!(bank.retire_below(1e-6), 1);
     assert!(!bank.is_live(8));
-    // A quiet mode in a short column (4), one of the slots freed by re-packing beside it.
+    // A quiet mode in a short column (4), with column 0 one mode shorter after re-packing.
     let short = 12;
     assert_eq!(bank.slot_of_mode[short] as usize % COLUMNS, 4);
     set(&mut bank, short, 1e-9);

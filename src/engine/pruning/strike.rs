@@ -256,10 +256,11 @@ impl Engine {
             if reason.generation == generation && !stale_tag && level_db < to_beat {
                 // Still off. Under the lowest curve the strike can leave, it surfaces no sooner
                 // than its margin under the curve allows.
-                let curve = reason.curve_db - reason.fall_db * (now - reason.at) as f32 + lift_db;
+                let unlifted = reason.curve_db - reason.fall_db * (now - reason.at) as f32;
+                let curve = unlifted + lift_db;
                 let fall = DB_PER_NEPER * d.delta as f32;
                 let closing = reason.fall_db - fall;
-                let lowest = (curve - lift_db + least_lift_db).max(reason.threshold_db);
+                let lowest = (unlifted + least_lift_db).max(reason.threshold_db);
                 let recheck_at = if level_db >= lowest {
                     // Off only if its masker takes the strike well enough in phase: the next
                     // analysis reads the masker as it is.
