@@ -94,6 +94,10 @@ fn run(s: &mut AbsorbScratch, n: usize) {
         let state_im = (g * (r * sin + i * cos)) as f32;
         let z_re = (state_re as f64 + add_re[k]) as f32;
         let z_im = (state_im as f64 + add_im[k]) as f32;
+        // A pole decaying hundreds of nepers within the pulse overflows the pulse referred back
+        // to its start: such a mode is silent by the pulse's end, and is left silent.
+        let finite = (z_re * z_re + z_im * z_im).is_finite();
+        let (z_re, z_im) = if finite { (z_re, z_im) } else { (0.0, 0.0) };
         out_re[k] = z_re;
         out_im[k] = z_im;
         out_db[k] = power_to_db(z_re * z_re + z_im * z_im);
@@ -171,6 +175,23 @@ mod tests {
         // The portable loop, and the dispatch (AVX2 where the CPU has it).
         check_batch(run);
         check_batch(|s, n| s.run(n));
+    }
+
+    #[test]
+    fn a_pulse_too_big_to_refer_back_leaves_the_mode_silent() {
+        let dispatch = |s: &mut AbsorbScratch, n: usize| s.run(n);
+        for run_batch in [run as fn(&mut AbsorbScratch, usize), dispatch] {
+            let mut s = AbsorbScratch::new(4);
+            s.re[..4].fill(0.1);
+            s.add_re[..4].copy_from_slice(&[1e300, f64::INFINITY, f64::NAN, 0.5]);
+            run_batch(&mut s, 4);
+            for k in 0..3 {
+                assert_eq!((s.out_re[k], s.out_im[k]), (0.0, 0.0), "entry {k}");
+                assert_eq!(s.out_db[k], power_to_db(0.0), "entry {k}");
+            }
+            // At phase 0 the state is the snapshot: 0.1 + 0.5.
+            assert!((s.out_re[3] - 0.6).abs() < 1e-6 && s.out_im[3].abs() < 1e-6);
+        }
     }
 
     fn check_batch(run_batch: impl Fn(&mut AbsorbScratch, usize)) {

@@ -227,7 +227,13 @@ impl ResonatorBank {
             let ahead = pulse.prepared().response(p, played as u32, u32::MAX);
             z = z.sub(p.powi(played as u32).mul(ahead).scale(d.gain as f64));
         }
-        (z.re as f32, z.im as f32)
+        let (re, im) = (z.re as f32, z.im as f32);
+        // A pulse too big to refer back (`absorb_strike` left the mode silent): nothing to undo.
+        if (re * re + im * im).is_finite() {
+            (re, im)
+        } else {
+            (0.0, 0.0)
+        }
     }
 }
 
