@@ -617,8 +617,9 @@ fn modes_that_cannot_be_switched_take_no_place_from_stronger_ones() {
 #[test]
 fn a_masked_mode_fading_out_takes_no_place_under_the_budget() {
     // A 62 Hz mode 6 dB under a 55 Hz one is masked: it fades out over two of its periods
-    // (33 ms in whole control periods), past the next analysis frame. Seven quiet modes far above fill the budget of eight
-    // with the loud one. Leaving, the masked mode must not push the quietest of them out.
+    // (33 ms in whole control periods), past the next analysis frame. Seven quiet modes far
+    // above fill the budget of eight with the loud one. Leaving, the masked mode must not push
+    // the quietest of them out.
     let mut modes = vec![(55.0, 1.0, 1.0), (62.0, 1.0, 0.5)];
     let quiet_hz = [
         2_000.0, 2_600.0, 3_300.0, 4_100.0, 5_000.0, 6_000.0, 7_000.0,
@@ -627,14 +628,22 @@ fn a_masked_mode_fading_out_takes_no_place_under_the_budget() {
     let mut bank = simple_bank(&modes);
     bank.root_hz = Some(55.0);
     let mut e = pruned_engine(&bank);
-    let mut c = e.controls().clone();
-    c.mode_budget = 8;
-    e.set_controls(&c);
     let masked = mode_at(&e, 62.0);
     let quiet: Vec<usize> = quiet_hz.iter().map(|&f| mode_at(&e, f)).collect();
+    // Struck with pruning off, so the masked mode starts computed (with pruning on, the strike
+    // would leave it dormant at once); pruning and the budget come on before the analysis at
+    // 20 ms, which switches it off.
+    let mut c = e.controls().clone();
+    c.pruning = false;
+    e.set_controls(&c);
+    strike(&mut e, 0.005);
+    assert!(switched_off(&e).is_empty());
+    c.pruning = true;
+    c.mode_budget = 8;
+    e.set_controls(&c);
     // Past the analysis at 20 ms (the masked mode still fading) and the 5 ms fade a mode switched
     // off there would take.
-    strike(&mut e, 0.03);
+    run(&mut e, 0.025);
     let off = switched_off(&e);
     assert!(!off.contains(&masked), "still fading: {off:?}");
     assert!(
@@ -645,4 +654,48 @@ fn a_masked_mode_fading_out_takes_no_place_under_the_budget() {
     run(&mut e, 0.03);
     let off = switched_off(&e);
     assert_eq!(off, vec![masked]);
+}
+
+#[test]
+fn modes_a_strike_starts_under_a_masking_curve_are_never_computed() {
+    // The bank of the first test, struck for the first time: the strike decides at once, so
+    // the masked neighbour starts dormant, taking the strike analytically, and no fade is spent
+    // on it; the two heard modes compute it from its first sample, with no ghost beside them.
+    let bank = simple_bank(&[
+        (1_000.0, 1.0, 1.0),
+        (1_080.0, 1.0, 0.003),
+        (6_000.0, 1.0, 0.003),
+    ]);
+    let mut e = pruned_engine(&bank);
+    let masked = mode_at(&e, 1_080.0);
+    let period = CONTROL_PERIOD as f64 / RATE as f64;
+    strike(&mut e, period);
+    assert_eq!(switched_off(&e), vec![masked]);
+    assert_eq!(
+        e.pruning_stats().switched_off,
+        0,
+        "switched off after computing"
+    );
+    let stats = e.stats();
+    assert_eq!((stats.dormant_modes, stats.fading_modes), (1, 0));
+    // Its energy is what the strike gave it, as in a full render.
+    let mut full = pruned_engine(&bank);
+    let mut c = full.controls().clone();
+    c.pruning = false;
+    full.set_controls(&c);
+    strike(&mut full, period);
+    let energy = |e: &Engine| {
+        let mut energy = None;
+        e.visit_mode_energies(|m, x| {
+            if m == masked {
+                energy = Some(x);
+            }
+        });
+        energy.expect("the masked mode sounds")
+    };
+    let (pruned, reference) = (energy(&e), energy(&full));
+    assert!(
+        (pruned - reference).abs() <= 1e-4 * reference,
+        "{pruned} against {reference}"
+    );
 }

@@ -432,7 +432,9 @@ impl Engine {
             .max(1.0) as u32;
         let threshold = db_to_gain(c.truncation_db);
         let kind = c.exciter;
-        let dormant = self.prepare_strike(i, kind);
+        // With pruning, modes the strike restarts are judged before they are computed.
+        let start_dormant = c.pruning && kind != ExciterKind::Noise;
+        self.prepare_strike(i, kind);
         self.voices[i].strike(
             &self.bank,
             &self.decay,
@@ -443,8 +445,9 @@ impl Engine {
             amplitude,
             len,
             threshold,
+            start_dormant,
         );
-        if dormant {
+        if self.voices[i].modes.num_dormant() > 0 {
             self.settle_strike(i, kind, amplitude, len);
         }
     }
@@ -578,6 +581,7 @@ impl Engine {
                     0.0,
                     1,
                     0.0,
+                    false,
                 );
                 v.exciter.reset();
             }

@@ -14,10 +14,11 @@
 //! 4. fades the modes switched off out (their state then evolves analytically) and fades modes
 //!    that have become audible back in, in phase.
 //!
-//! A strike decides at once which of its voice's dormant modes it makes audible ([`strike`]):
-//! those are woken at its exact sample and take it computed (under a budget, as many as the
-//! budget would keep); the others take it analytically and stay dormant. Audio input, which is
-//! not known in advance, wakes every dormant mode of the input voice.
+//! A strike decides at once which of its voice's dormant modes it makes audible ([`strike`]),
+//! the modes it starts from rest among them (they start dormant): those are woken at its exact
+//! sample and take it computed (under a budget, as many as the budget would keep); the others
+//! take it analytically and stay dormant, never computed. Audio input, which is not known in
+//! advance, wakes every dormant mode of the input voice.
 //!
 //! Most frames look only at what may have changed. Every level falls linearly in dB, so it is
 //! known how long each verdict holds: a heard mode cannot sink under today's masking envelope or
@@ -320,7 +321,7 @@ fn frame_samples(frame_ms: f32, sample_rate_hz: f64) -> u64 {
 /// Samples of a fade for a mode at `theta` radians per sample: [`FADE_S`] or [`FADE_PERIODS`] of
 /// the mode, whichever is longer (at most [`MAX_FADE_S`]), rounded up to whole control periods so
 /// fades started on a tick end on one.
-fn fade_samples(theta: f32, sample_rate_hz: f64) -> u32 {
+pub(in crate::engine) fn fade_samples(theta: f32, sample_rate_hz: f64) -> u32 {
     let periods = FADE_PERIODS * std::f64::consts::TAU / (theta as f64).max(1e-9);
     let samples = (FADE_S * sample_rate_hz)
         .max(periods)

@@ -3,6 +3,7 @@
 use std::f64::consts::TAU;
 
 use super::prepared::PreparedBank;
+use super::pruning::fade_samples;
 use super::{NoteExpression, VoiceModulation, MAX_EXPRESSION_SEMITONES};
 use crate::dsp::coeffs::{t60_to_decay, ModeCoeffs, MAX_FREQ_RATIO};
 use crate::dsp::{Exciter, ExciterKind, ResonatorBank};
@@ -194,7 +195,9 @@ impl Voice {
 
     /// Strikes the voice: restarts modes that have died (unless the strike cannot lift them above
     /// `threshold`), sets every mode's gain to `gains` (the bank's at the strike point), tunes the
-    /// voice to `tuning` and starts the pulse.
+    /// voice to `tuning` and starts the pulse. With `start_dormant` (pruning on, a pulse known in
+    /// advance) the modes restarted are not computed until the pruner hears them: they start
+    /// dormant, for [`crate::engine::Engine`]'s `settle_strike` to judge at once.
     #[allow(clippy::too_many_arguments)] // two call sites; the values are all distinct and plain
     pub fn strike(
         &mut self,
@@ -207,6 +210,7 @@ impl Voice {
         amplitude: f32,
         len_samples: u32,
         threshold: f32,
+        start_dormant: bool,
     ) {
         let pitch = tuning.log_pitch.exp();
         let bound = amplitude * kind.peak_bound(len_samples);
@@ -217,7 +221,10 @@ impl Voice {
                 continue;
             }
             let theta = TAU * bank.freq_hz[m] * pitch / sample_rate_hz;
-            if theta < THETA_MAX {
+            if theta < THETA_MAX && start_dormant {
+                let fade = fade_samples(theta as f32, sample_rate_hz);
+                self.modes.start_dormant(m, gain, fade);
+            } else if theta < THETA_MAX {
                 // Coefficients follow below, for all modes at once.
                 self.modes.activate(
                     m,

@@ -57,6 +57,10 @@ pub(super) struct Dormant {
     /// referred to the sample before the pulse (`None` until a strike asks for it): strikes on
     /// an object usually repeat their mallet.
     pub response: Option<(PulseShape, u32, f64, f64)>,
+    /// Bank clock at which it started from rest without being computed
+    /// ([`ResonatorBank::start_dormant`]), else `u64::MAX`: woken at that instant it has no
+    /// ringing of its own to fade back in.
+    pub rest_at: u64,
 }
 
 impl Dormant {
@@ -78,6 +82,7 @@ impl Dormant {
         p_im: 0.0,
         tag: 0,
         response: None,
+        rest_at: u64::MAX,
     };
 
     /// Takes a new pole from now on (after [`Dormant::advance_to`]).
@@ -222,12 +227,45 @@ impl ResonatorBank {
                 p_im: self.q_im[slot] as f64,
                 tag,
                 response: None,
+                rest_at: u64::MAX,
             },
             recheck_at,
         );
         (self.theta[slot], self.delta[slot]) = (theta, delta);
         self.start_fade(slot, FADE_DEPTH_NEPERS / len as f64, len);
         self.num_fading_out += 1;
+    }
+
+    /// Makes `mode` sound from rest without computing it, unless it already sounds: a strike
+    /// about to come then reaches it analytically ([`ResonatorBank::absorb_strike`]), and the
+    /// pruner wakes it at the strike's sample only if it is heard. Its pole comes with the next
+    /// [`ResonatorBank::set_poles_with`], which must precede the strike; `fade_samples` is how
+    /// long it fades in or out if switched later. Due for a look now. Returns whether it was
+    /// added.
+    pub fn start_dormant(&mut self, mode: usize, gain: f32, fade_samples: u32) -> bool {
+        if self.is_live(mode) {
+            return false;
+        }
+        let column = self.column_for(mode);
+        self.claimed[column] += 1;
+        let now = self.clock;
+        self.push_record(
+            Dormant {
+                mode: mode as u32,
+                column: column as u32,
+                gain,
+                fade_len: fade_samples.max(1),
+                snap_db: f32::NEG_INFINITY,
+                at: now,
+                // The pole at rest (`p = 1`) until the next `set_pole`.
+                tag: NONE,
+                rest_at: now,
+                ..Dormant::EMPTY
+            },
+            now,
+        );
+        self.num_started += 1;
+        true
     }
 
     /// Brings dormant `mode` back, fading it in over `fade_samples` so that it reaches its true

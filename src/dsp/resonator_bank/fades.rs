@@ -152,13 +152,20 @@ impl ResonatorBank {
     pub(super) fn wake_record(&mut self, r: usize) {
         let now = self.clock;
         let mut d = self.take_record(r);
-        d.advance_to(now);
-        let (re, im) = self.undo_pending_pulses(&d, d.state());
-        self.woken += 1;
         let column = d.column as usize;
         let fresh = self.push_slot(d.mode, column);
         (self.theta[fresh], self.delta[fresh]) = (d.theta, d.delta);
         self.gain[fresh] = d.gain;
+        // New slots' coefficients all at once (a strike's retune usually does it first).
+        self.coeffs_stale = true;
+        if d.rest_at == now {
+            // Started from rest at this instant: all it holds is what the strike under way
+            // adds, which the slot computes. Nothing to fade back in.
+            return;
+        }
+        d.advance_to(now);
+        let (re, im) = self.undo_pending_pulses(&d, d.state());
+        self.woken += 1;
         let ghost = self.push_slot(d.mode | GHOST, column);
         let start = (-FADE_DEPTH_NEPERS).exp() as f32;
         self.re[ghost] = re * start;
@@ -169,8 +176,6 @@ impl ResonatorBank {
         self.fade_end[ghost] = now + len;
         self.next_fade_end = self.next_fade_end.min(now + len);
         self.num_fading += 1;
-        // New slots' coefficients all at once (a strike's retune usually does it first).
-        self.coeffs_stale = true;
     }
 
     /// Starts a fade of `len` samples adding `fade_delta` to a steady slot's decay.

@@ -37,6 +37,9 @@ pub struct DormantMode {
     pub recheck_at: u64,
     /// The pruner's note.
     pub tag: u32,
+    /// Whether it started from rest at this instant ([`ResonatorBank::start_dormant`]) and has
+    /// not been looked at yet.
+    pub from_rest: bool,
 }
 
 impl ResonatorBank {
@@ -136,6 +139,7 @@ impl ResonatorBank {
                 delta: d.delta,
                 recheck_at,
                 tag: d.tag,
+                from_rest: d.rest_at == now,
             });
         }
         self.earliest_recheck = earliest;

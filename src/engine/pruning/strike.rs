@@ -1,11 +1,12 @@
 //! A strike on a voice with dormant modes.
 //!
 //! The strike is known in full when it comes (an impulse or a mallet pulse of known area and
-//! length), so every dormant mode of the struck voice takes it analytically
+//! length), so every dormant mode of the struck voice, and every mode it starts from rest (they
+//! start dormant, with no reason yet to be off), takes it analytically
 //! ([`crate::dsp::ResonatorBank::absorb_strike`]) and its level afterwards is known exactly. Most
 //! stay under what kept them off (the masking curve over them, falling as its masker decays, or
-//! the threshold in quiet), and stay dormant: a comparison each. The few lifted above it are
-//! judged by the masking pass, against the maskers carried over from the last analysis and the
+//! the threshold in quiet), and stay dormant: a comparison each. The few lifted above it, and the
+//! modes started, are judged by the masking pass, against the maskers carried over from the last analysis and the
 //! voice's own computed modes as the strike leaves them; those found audible are woken at the
 //! strike's exact sample and compute it from its first sample, their old ringing fading back in
 //! beside them. A noise burst is not known in advance: it wakes them all.
@@ -28,9 +29,9 @@ use crate::engine::Engine;
 
 impl Engine {
     /// Before voice `i` is struck by `kind`: modes fading in or out are woken (through their
-    /// poles they cannot take input), and every dormant one too for noise. Returns whether
-    /// dormant modes remain, to take the strike analytically with [`Engine::settle_strike`].
-    pub(in crate::engine) fn prepare_strike(&mut self, i: usize, kind: ExciterKind) -> bool {
+    /// poles they cannot take input), and every dormant one too for noise. Dormant modes left
+    /// (and those the strike starts dormant) take it analytically with [`Engine::settle_strike`].
+    pub(in crate::engine) fn prepare_strike(&mut self, i: usize, kind: ExciterKind) {
         self.pruner.struck[i] = true;
         // Under a budget, the modes the strike starts are ranked at the next control tick rather
         // than a frame later, so the cap holds within a control period.
@@ -43,7 +44,7 @@ impl Engine {
         }
         let modes = &mut self.voices[i].modes;
         if modes.num_dormant() + modes.num_fading() == 0 {
-            return false;
+            return;
         }
         let start = self.pruner.profiling.then(Instant::now);
         match kind {
@@ -53,7 +54,6 @@ impl Engine {
         if let Some(start) = start {
             self.pruner.stats.strike_ns += start.elapsed().as_nanos() as u64;
         }
-        modes.num_dormant() > 0
     }
 
     /// After voice `i` has been struck by `kind` of `amplitude` over `len` samples with the gains
@@ -253,7 +253,8 @@ impl Engine {
                 }
             };
             let to_beat = reason.level_to_beat(now) + lift_db;
-            if reason.generation == generation && !stale_tag && level_db < to_beat {
+            // A mode started from rest by this strike has no reason yet.
+            if !d.from_rest && reason.generation == generation && !stale_tag && level_db < to_beat {
                 // Still off. Under the lowest curve the strike can leave, it surfaces no sooner
                 // than its margin under the curve allows.
                 let unlifted = reason.curve_db - reason.fall_db * (now - reason.at) as f32;
