@@ -699,3 +699,25 @@ fn modes_a_strike_starts_under_a_masking_curve_are_never_computed() {
         "{pruned} against {reference}"
     );
 }
+
+#[test]
+fn a_dormant_mode_under_the_threshold_in_quiet_is_not_looked_at_until_struck() {
+    // 15 kHz 40 dB under a 1 kHz mode, far beyond its masking curve: under the threshold in
+    // quiet there (about 51 dB SPL), and only getting quieter. The once-a-second look at every
+    // dormant mode passes it over: over three seconds the analyses look at as many modes as
+    // without it.
+    let with = simple_bank(&[(1_000.0, 1.0, 1.0), (15_000.0, 0.5, 0.01)]);
+    let without = simple_bank(&[(1_000.0, 1.0, 1.0)]);
+    let looks = |bank: &Bank| {
+        let mut e = pruned_engine(bank);
+        strike(&mut e, 0.1);
+        let before = e.pruning_stats().candidates;
+        run(&mut e, 3.0);
+        (e.pruning_stats().candidates - before, switched_off(&e))
+    };
+    let (with_looks, off) = looks(&with);
+    assert_eq!(off.len(), 1, "the quiet mode is dormant");
+    let (without_looks, _) = looks(&without);
+    assert!(without_looks > 0);
+    assert_eq!(with_looks, without_looks);
+}

@@ -27,8 +27,9 @@
 //! again when that time comes, when its voice is struck, or when its masker's voice changes
 //! (retuned, stolen, silenced); the maskers of the other modes carry over from frame to frame.
 //! Every [`FULL_EVERY`] frames every computed mode is looked at, and about every
-//! [`DORMANT_FULL_S`] every dormant one too, whatever its recheck time says; whenever the settings
-//! change, everything is.
+//! [`DORMANT_FULL_S`] every dormant one too, whatever its recheck time says (except those under
+//! the threshold in quiet, which only get quieter until struck); whenever the settings change,
+//! everything is.
 
 mod analysis;
 mod candidates;

@@ -138,7 +138,7 @@ impl Engine {
             } else {
                 bank_now
             };
-            let generations = &p.generation;
+            let (generations, off) = (&p.generation, &p.off);
             v.modes.for_each_dormant(due, |d| {
                 let stale_tag = d.tag != NO_TAG && {
                     let masker = (d.tag >> 24) as usize;
@@ -148,6 +148,17 @@ impl Engine {
                 };
                 if !(dormant_full || stale_tag || d.recheck_at <= bank_now) {
                     return;
+                }
+                // Under the threshold in quiet at its tuning, a mode only gets quieter until its
+                // voice is struck (judged then) or its recheck time (at the latest, truncation)
+                // comes: the sweep and a masker's change pass it over.
+                if !recheck_all && d.recheck_at > bank_now {
+                    let reason = &off[vi * stride + d.mode];
+                    if reason.generation == generation
+                        && d.level_db + calibration_db < reason.threshold_db
+                    {
+                        return;
+                    }
                 }
                 // A driven voice cannot fade modes in: its dormant ones wait.
                 let flags = if idle && d.level_db < truncation_db {
