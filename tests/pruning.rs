@@ -721,3 +721,43 @@ fn a_dormant_mode_under_the_threshold_in_quiet_is_not_looked_at_until_struck() {
     assert!(without_looks > 0);
     assert_eq!(with_looks, without_looks);
 }
+
+#[test]
+fn turning_pruning_off_just_after_a_strike_brings_its_masked_modes_back() {
+    // The masked neighbour starts dormant at the strike; pruning is turned off before any
+    // analysis has looked at it. The next analysis still runs and brings it back, in phase:
+    // from then on the render is the unpruned one.
+    let bank = simple_bank(&[
+        (1_000.0, 1.0, 1.0),
+        (1_080.0, 1.0, 0.003),
+        (6_000.0, 1.0, 0.003),
+    ]);
+    let period = CONTROL_PERIOD as f64 / RATE as f64;
+    let mut e = pruned_engine(&bank);
+    strike(&mut e, period);
+    assert_eq!(switched_off(&e), vec![mode_at(&e, 1_080.0)]);
+    let mut c = e.controls().clone();
+    c.pruning = false;
+    e.set_controls(&c);
+    let pruned = run(&mut e, 0.2);
+    assert!(switched_off(&e).is_empty(), "left dormant");
+    assert_eq!(e.stats().fading_modes, 0);
+
+    let mut full = pruned_engine(&bank);
+    full.set_controls(&c);
+    strike(&mut full, period);
+    let reference = run(&mut full, 0.2);
+    // After the fade back in (at most 50 ms), the two agree.
+    let from = (0.1 * RATE as f64) as usize;
+    let error = peak(
+        &pruned[from..]
+            .iter()
+            .zip(&reference[from..])
+            .map(|(a, b)| a - b)
+            .collect::<Vec<_>>(),
+    );
+    assert!(
+        error <= 1e-4 * peak(&reference[from..]),
+        "differs by {error}"
+    );
+}

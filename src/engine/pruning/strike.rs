@@ -72,6 +72,9 @@ impl Engine {
             ExciterKind::Noise => return,
         };
         let start = self.pruner.profiling.then(Instant::now);
+        // Dormant modes are left whatever comes of it: the analyses must go on even if pruning
+        // and the budget are turned off before the next one, to bring them back.
+        self.pruner.engaged = true;
         let pulse = Pulse {
             shape,
             amplitude,
