@@ -6,7 +6,7 @@ mod common;
 
 use common::*;
 use modal_resonator::dsp::ExciterKind;
-use modal_resonator::engine::{Controls, Engine, NoteEvent, CONTROL_PERIOD};
+use modal_resonator::engine::{Controls, Engine, Note, NoteEvent, CONTROL_PERIOD};
 use modal_resonator::model::{Bank, Mode};
 
 const RATE: f32 = 48_000.0;
@@ -51,6 +51,27 @@ fn mode_at(e: &Engine, freq_hz: f64) -> usize {
 /// Renders `seconds` more with no events.
 fn run(e: &mut Engine, seconds: f64) -> Vec<f32> {
     render(e, &[], seconds, 256).0
+}
+
+/// Renders `samples` (a whole number of control periods) with `events` at the first sample.
+fn play(e: &mut Engine, events: &[NoteEvent], samples: usize) {
+    let n = CONTROL_PERIOD;
+    let (mut l, mut r) = (vec![0.0; n], vec![0.0; n]);
+    for k in 0..samples / n {
+        e.process(if k == 0 { events } else { &[] }, None, &mut l, &mut r);
+    }
+}
+
+/// Samples between analyses.
+fn frame(e: &Engine) -> usize {
+    (e.controls().analysis_frame_ms as f64 * 1e-3 * RATE as f64).round() as usize
+}
+
+/// Makes pitch follow the key.
+fn tracking(e: &mut Engine) {
+    let mut c = e.controls().clone();
+    c.key_tracking = 1.0;
+    e.set_controls(&c);
 }
 
 /// Renders a strike on the bank's root at time 0 and `seconds` of ringing.
@@ -760,4 +781,74 @@ fn turning_pruning_off_just_after_a_strike_brings_its_masked_modes_back() {
         error <= 1e-4 * peak(&reference[from..]),
         "differs by {error}"
     );
+}
+
+#[test]
+fn a_voice_taking_a_new_note_between_analyses_is_judged_at_its_new_pitch() {
+    // At the root the 15 kHz mode, 60 dB down, is under the threshold in quiet (about 51 dB
+    // SPL there) and dormant. The voice is choked and takes a note two octaves down before the
+    // next analysis: the mode now sounds at 3.75 kHz, 30 dB over the threshold there, and is
+    // heard from the strike on, as on a voice that never played the root.
+    let bank = simple_bank(&[(1_000.0, 1.0, 1.0), (15_000.0, 1.0, 1e-3)]);
+    let mut e = pruned_engine(&bank);
+    tracking(&mut e);
+    let (key, low) = (root(&e), root(&e) - 24);
+    let high = mode_at(&e, 15_000.0);
+    // Up to one control period after an analysis frame boundary, so none comes before the
+    // check.
+    let samples = 5 * frame(&e) + CONTROL_PERIOD;
+    play(&mut e, &[on(0, key, 1.0)], samples);
+    assert_eq!(switched_off(&e), vec![high]);
+    let analyses = e.pruning_stats().analyses;
+    let renote = [
+        NoteEvent::Choke {
+            time: 0,
+            note: Note::key(key),
+        },
+        on(0, low, 1.0),
+    ];
+    play(&mut e, &renote, CONTROL_PERIOD);
+    assert_eq!(
+        e.pruning_stats().analyses,
+        analyses,
+        "an analysis came between"
+    );
+
+    let mut fresh = pruned_engine(&bank);
+    tracking(&mut fresh);
+    play(&mut fresh, &[on(0, low, 1.0)], CONTROL_PERIOD);
+    assert!(
+        switched_off(&fresh).is_empty(),
+        "not heard on a fresh voice"
+    );
+    assert!(switched_off(&e).is_empty(), "judged at the old pitch");
+}
+
+#[test]
+fn a_masker_voice_taking_a_new_note_between_analyses_unmasks_at_the_next_one() {
+    // A soft note a semitone up (40 dB down) lies under the root's masking curve, its mode
+    // dormant. The root's voice is choked and takes a note two octaves up just after an
+    // analysis: the next analysis finds the masker gone and brings the soft note back.
+    let bank = simple_bank(&[(1_000.0, 1.0, 1.0)]);
+    let mut e = pruned_engine(&bank);
+    tracking(&mut e);
+    let mut c = e.controls().clone();
+    c.velocity_sensitivity = 1.0;
+    e.set_controls(&c);
+    let (key, frame) = (root(&e), frame(&e));
+    play(
+        &mut e,
+        &[on(0, key, 1.0), on(0, key + 1, 0.1)],
+        5 * frame + CONTROL_PERIOD,
+    );
+    assert_eq!(e.stats().dormant_modes, 1, "the soft note is masked");
+    let renote = [
+        NoteEvent::Choke {
+            time: 0,
+            note: Note::key(key),
+        },
+        on(0, key + 24, 1.0),
+    ];
+    play(&mut e, &renote, frame);
+    assert_eq!(e.stats().dormant_modes, 0, "still masked by a note gone");
 }

@@ -182,6 +182,9 @@ pub(super) struct Pruner {
     since_dormant_full: u32,
     /// Whether modes may be dormant or fading somewhere.
     engaged: bool,
+    /// Whether a strike has found a voice changed (a new note, a new tuning) since the last
+    /// analysis: the next one looks at what it masked.
+    changed: bool,
     /// Whether the next control tick is to analyse: the input has woken modes, or a strike
     /// came under a budget.
     pending: bool,
@@ -222,6 +225,7 @@ impl Pruner {
             since_full: 0,
             since_dormant_full: 0,
             engaged: false,
+            changed: false,
             pending: false,
             settings: None,
             calibration_db: 0.0,
@@ -259,9 +263,23 @@ impl Pruner {
     /// Forgets what it knew about the voices (they have all been freed).
     pub fn forget(&mut self) {
         self.engaged = false;
+        self.changed = false;
         self.pending = false;
         self.settings = None;
         self.maskers.len = 0;
+    }
+
+    /// Notes what voice `i` is now. If that has changed since last noted, its generation moves
+    /// on: verdicts, maskers and cached psychoacoustics of the old one no longer hold. Returns
+    /// whether it did.
+    fn watch_voice(&mut self, i: usize, v: &Voice) -> bool {
+        let watch = VoiceWatch::of(v);
+        if self.watch[i] == watch {
+            return false;
+        }
+        self.watch[i] = watch;
+        self.generation[i] = self.generation[i].wrapping_add(1) & GENERATION_MASK;
+        true
     }
 
     /// The input has woken modes: look again at the next tick.

@@ -6,7 +6,7 @@ use std::time::Instant;
 use super::candidates::{
     Reading, DORMANT, DRIVEN, DROP, LEAVING, LOCKED, OVER_BUDGET, UNSURE_MASKER,
 };
-use super::{fade_samples, frame_samples, samples_to_cross, VoiceWatch};
+use super::{fade_samples, frame_samples, samples_to_cross};
 use super::{DORMANT_FULL_S, FULL_EVERY, GENERATION_MASK, NO_TAG};
 use crate::dsp::coeffs::gain_to_db;
 use crate::dsp::pruning::{keep_most_energetic, Verdict, PRIOR};
@@ -62,14 +62,10 @@ impl Engine {
             p.calibration_db = calibration_db;
         }
         let num_voices = voices.len();
-        let mut any_changed = false;
+        // A voice a strike found changed since the last analysis counts as changed now.
+        let mut any_changed = std::mem::take(&mut p.changed);
         for (i, v) in voices.iter().chain(input_voice.as_ref()).enumerate() {
-            let watch = VoiceWatch::of(v);
-            if p.watch[i] != watch {
-                p.watch[i] = watch;
-                p.generation[i] = p.generation[i].wrapping_add(1) & GENERATION_MASK;
-                any_changed = true;
-            }
+            any_changed |= p.watch_voice(i, v);
             let strikes = (v.modes.num_started(), v.modes.num_woken());
             p.struck[i] |= p.strikes[i] != strikes;
             p.strikes[i] = strikes;

@@ -196,6 +196,9 @@ impl Engine {
         } = self;
         let now = *clock;
         let reading = Reading::new(calibration_db, *sample_rate_hz, cap.is_some());
+        // A voice taking a new note (or retuned) since the last analysis is judged as what it is
+        // now, not by what was worked out for the old one.
+        p.changed |= p.watch_voice(i, &voices[i]);
         let generation = p.generation[i];
         let stride = p.cands.stride;
         let modes = &mut voices[i].modes;
