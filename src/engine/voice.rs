@@ -223,7 +223,7 @@ impl Voice {
             let theta = TAU * bank.freq_hz[m] * pitch / sample_rate_hz;
             if theta < THETA_MAX && start_dormant {
                 let fade = fade_samples(theta as f32, sample_rate_hz);
-                self.modes.start_dormant(m, gain, fade);
+                self.modes.start_dormant(m, fade);
             } else if theta < THETA_MAX {
                 // Coefficients follow below, for all modes at once.
                 self.modes.activate(

@@ -61,6 +61,12 @@ pub(super) struct Dormant {
     /// ([`ResonatorBank::start_dormant`]), else `u64::MAX`: woken at that instant it has no
     /// ringing of its own to fade back in.
     pub rest_at: u64,
+    /// Bank clock at which the pulses it took analytically end: until then its state runs ahead
+    /// of the truth by what they have not played yet.
+    pub pulse_end: u64,
+    /// Bound on its power until `pulse_end`, in dB: its amplitude before the pulses plus all
+    /// they can add.
+    pub pulse_peak_db: f32,
 }
 
 impl Dormant {
@@ -83,6 +89,8 @@ impl Dormant {
         tag: 0,
         response: None,
         rest_at: u64::MAX,
+        pulse_end: 0,
+        pulse_peak_db: f32::INFINITY,
     };
 
     /// Takes a new pole from now on (after [`Dormant::advance_to`]).
@@ -104,12 +112,18 @@ impl Dormant {
         self.at = now;
     }
 
-    /// Power `|z|^2` in dB at bank clock `t` (not before `at`).
+    /// Power `|z|^2` in dB at bank clock `t` (not before `at`); while the pulses it took play
+    /// (when its state runs ahead of the truth), at most their bound.
     #[inline]
     pub fn level_db_at(&self, t: u64) -> f32 {
         let log_gain = self.log_gain - self.delta * t.saturating_sub(self.at) as f64;
         // 20 log10 of the amplitude: a neper of amplitude is DB_PER_NEPER dB.
-        self.snap_db + (DB_PER_NEPER as f64 * log_gain) as f32
+        let level = self.snap_db + (DB_PER_NEPER as f64 * log_gain) as f32;
+        if t < self.pulse_end {
+            level.min(self.pulse_peak_db)
+        } else {
+            level
+        }
     }
 
     /// Power `|z|^2` at bank clock `t` (not before `at`).
@@ -228,6 +242,8 @@ impl ResonatorBank {
                 tag,
                 response: None,
                 rest_at: u64::MAX,
+                pulse_end: 0,
+                pulse_peak_db: f32::INFINITY,
             },
             recheck_at,
         );
@@ -237,12 +253,12 @@ impl ResonatorBank {
     }
 
     /// Makes `mode` sound from rest without computing it, unless it already sounds: a strike
-    /// about to come then reaches it analytically ([`ResonatorBank::absorb_strike`]), and the
-    /// pruner wakes it at the strike's sample only if it is heard. Its pole comes with the next
-    /// [`ResonatorBank::set_poles_with`], which must precede the strike; `fade_samples` is how
-    /// long it fades in or out if switched later. Due for a look now. Returns whether it was
-    /// added.
-    pub fn start_dormant(&mut self, mode: usize, gain: f32, fade_samples: u32) -> bool {
+    /// about to come then reaches it analytically ([`ResonatorBank::absorb_strike`], which gives
+    /// it its gain; until then it takes nothing), and the pruner wakes it at the strike's sample
+    /// only if it is heard. Its pole comes with the next [`ResonatorBank::set_poles_with`],
+    /// which must precede the strike; `fade_samples` is how long it fades in or out if switched
+    /// later. Due for a look now. Returns whether it was added.
+    pub fn start_dormant(&mut self, mode: usize, fade_samples: u32) -> bool {
         if self.is_live(mode) {
             return false;
         }
@@ -253,7 +269,7 @@ impl ResonatorBank {
             Dormant {
                 mode: mode as u32,
                 column: column as u32,
-                gain,
+                gain: 0.0,
                 fade_len: fade_samples.max(1),
                 snap_db: f32::NEG_INFINITY,
                 at: now,

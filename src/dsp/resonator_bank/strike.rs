@@ -7,9 +7,18 @@
 //! pulse's contribution referred to that instant, `g sum_j x_j p^-(j+1)`, is added (in closed form
 //! for the raised cosine, seed 000 eq. 4.5). Until the pulse has ended the record runs ahead of
 //! the truth by the part not yet played, so a mode woken then has that part taken back.
+//!
+//! A record thus holds the truth on the understanding that what is left of the pulses under way
+//! reaches it with its own gain. A computed mode takes the rest of an earlier pulse with the
+//! gain of the latest strike, so a strike that changes a record's gain also gives it the rest of
+//! the earlier pulses at the difference; a mode started from rest has a gain of zero until then.
+//! Referred back to the strike, a pulse grows as `e^(delta L)`: modes that decay more than
+//! [`MAX_ABSORB_NEPERS`] within what is left of the pulses are woken before it instead, and
+//! computed through it (they soon die away).
 
 use super::dormant::Dormant;
 use super::{ResonatorBank, NONE};
+use crate::dsp::coeffs::db_to_gain;
 
 /// Most pulses kept track of at once (as many as one exciter overlaps).
 pub(super) const MAX_PULSES: usize = 4;
@@ -17,6 +26,12 @@ pub(super) const MAX_PULSES: usize = 4;
 /// Below this distance from 1 a geometric ratio is summed term by term rather than in closed
 /// form (the closed form divides by it).
 const NEAR_ONE: f64 = 1e-3;
+
+/// Most decay, in nepers, over what is left of the pulses under way for a dormant mode to take
+/// a strike analytically: referred back to the strike the pulse grows by as much, and taking its
+/// unplayed part back loses that many nepers of an `f32` state's precision (`e^6` of `2^-24`,
+/// about -92 dB).
+pub(super) const MAX_ABSORB_NEPERS: f64 = 6.0;
 
 /// The kinds of pulse a dormant mode can take without being computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -70,7 +85,7 @@ impl Pulse {
 
 /// A pulse's response constants.
 #[derive(Debug, Clone, Copy)]
-struct Prepared {
+pub(super) struct Prepared {
     /// Area.
     amplitude: f64,
     /// Samples.
@@ -82,6 +97,14 @@ struct Prepared {
 }
 
 impl Prepared {
+    /// Constants of no pulse.
+    const NONE: Self = Self {
+        amplitude: 0.0,
+        len: 1,
+        rot: C::ONE,
+        half_back: C::ONE,
+    };
+
     /// `sum_(j = a)^(b - 1) x_j w^(j + 1)` with `w = 1 / p`: the part of the pulse from sample `a`
     /// to `b`, referred to the sample before it starts, for a mode of pole `p`.
     fn response(&self, p: C, a: u32, b: u32) -> C {
@@ -133,28 +156,52 @@ impl ResonatorBank {
     /// starting at the next sample, with input gain `gain_of(mode)`, without being computed. With
     /// `due`, each is due for another look by the pruner now; otherwise its recheck time stands
     /// until the pruner sets another from the strike's outcome. A mode the pruner then wakes
-    /// ([`ResonatorBank::wake`]) computes the strike from its first sample.
+    /// ([`ResonatorBank::wake`]) computes the strike from its first sample. Modes decaying too
+    /// fast to take it analytically are woken at once. Returns how many took it.
     pub fn absorb_strike(
         &mut self,
         pulse: Pulse,
         due: bool,
         mut gain_of: impl FnMut(usize) -> f32,
-    ) {
+    ) -> usize {
         if self.num_dormant == 0 {
-            return;
+            return 0;
         }
         let now = self.clock;
-        // Forget pulses that have ended; note this one.
+        // Forget pulses that have ended; what is left of the others, and for how long.
         let mut kept = 0;
+        let mut span = pulse.samples() as u64;
+        let mut reach = pulse.amplitude.abs();
+        let mut earlier = [(0, Prepared::NONE); MAX_PULSES];
         for k in 0..self.num_pulses {
             let (start, old) = self.pulses[k];
-            if start + (old.samples() as u64) > now {
+            let end = start + old.samples() as u64;
+            if end > now {
                 self.pulses[kept] = self.pulses[k];
+                earlier[kept] = ((now - start) as u32, old.prepared());
+                span = span.max(end - now);
+                reach += old.amplitude.abs();
                 kept += 1;
+            }
+        }
+        self.num_pulses = kept;
+        // Modes too damped to refer the pulses back to now are computed through them: woken
+        // before this pulse is noted (their old ringing, less what it has not played of the
+        // earlier pulses, fades back in), with this strike's gain.
+        for r in (0..self.num_dormant).rev() {
+            let d = &self.dormant[r];
+            if self.slot_of_mode[d.mode as usize] == NONE
+                && d.delta * span as f64 > MAX_ABSORB_NEPERS
+            {
+                let mode = d.mode as usize;
+                self.wake_record(r);
+                let slot = self.slot_of_mode[mode] as usize;
+                self.gain[slot] = gain_of(mode);
             }
         }
         if kept == MAX_PULSES {
             self.pulses.rotate_left(1);
+            earlier.rotate_left(1);
             kept -= 1;
         }
         self.pulses[kept] = (now, pulse);
@@ -176,26 +223,43 @@ impl ResonatorBank {
             }
             d.advance_to(now);
             let gain = gain_of(d.mode as usize);
+            let p = C::new(d.p_re, d.p_im);
             let response = match d.response {
                 Some((shape, len, re, im)) if (shape, len) == key => C::new(re, im),
                 _ => {
-                    let r = prepared.response(C::new(d.p_re, d.p_im), 0, u32::MAX);
+                    let r = prepared.response(p, 0, u32::MAX);
                     d.response = Some((key.0, key.1, r.re, r.im));
                     r
                 }
             };
-            let added = response.scale(pulse.amplitude as f64 * gain as f64);
+            let mut added = response.scale(pulse.amplitude as f64 * gain as f64);
+            // What is left of the earlier pulses now comes with this strike's gain.
+            let change = gain as f64 - d.gain as f64;
+            if change != 0.0 {
+                for &(played, old) in &earlier[..kept] {
+                    let rest = p.powi(played).mul(old.response(p, played, u32::MAX));
+                    added = added.add(rest.scale(change));
+                }
+            }
             scratch.phase[n] = d.phase;
             scratch.log_gain[n] = d.log_gain;
             scratch.re[n] = d.re;
             scratch.im[n] = d.im;
             scratch.add_re[n] = added.re;
             scratch.add_im[n] = added.im;
+            // Its amplitude now is at most what bounded it through the earlier pulses.
+            scratch.cap[n] = if now < d.pulse_end {
+                db_to_gain(d.pulse_peak_db)
+            } else {
+                f32::INFINITY
+            };
+            scratch.reach[n] = gain.abs() * reach;
             scratch.record[n] = r as u32;
             n += 1;
             d.phase = 0.0;
             d.log_gain = 0.0;
             d.gain = gain;
+            d.pulse_end = now + span;
             if due {
                 self.recheck[r] = now;
             }
@@ -206,10 +270,12 @@ impl ResonatorBank {
             d.re = scratch.out_re[k];
             d.im = scratch.out_im[k];
             d.snap_db = scratch.out_db[k];
+            d.pulse_peak_db = scratch.out_peak_db[k];
         }
         if due {
             self.earliest_recheck = self.earliest_recheck.min(now);
         }
+        n
     }
 
     /// The state of record `d` (brought to now) with the unplayed part of any pulse it took

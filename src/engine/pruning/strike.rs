@@ -82,13 +82,12 @@ impl Engine {
         };
         let gains = &self.strike_gains;
         let modes = &mut self.voices[i].modes;
-        self.pruner.stats.absorbed += modes.num_dormant() as u64;
         let bound = amplitude * kind.peak_bound(len);
         let cap = self.budget.cap(&self.controls, self.sample_rate_hz);
         // With pruning the modes are judged below; with a budget alone, ranked by energy;
         // otherwise the next analysis looks at them.
         let pruning = self.controls.pruning;
-        modes.absorb_strike(pulse, !pruning, |m| gains[m]);
+        self.pruner.stats.absorbed += modes.absorb_strike(pulse, !pruning, |m| gains[m]) as u64;
         if pruning {
             self.judge_struck(i, bound, cap);
         } else if let Some(cap) = cap {
