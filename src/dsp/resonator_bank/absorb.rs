@@ -27,20 +27,16 @@ pub(super) struct AbsorbScratch {
     pub add_re: Vec<f64>,
     /// Imaginary part of what the pulse adds.
     pub add_im: Vec<f64>,
-    /// Bound on the amplitude before the pulse (from the pulses under way; infinite if none).
-    pub cap: Vec<f32>,
-    /// Bound on what the pulses under way can add to the amplitude from now on.
-    pub reach: Vec<f32>,
     /// The record each entry came from.
     pub record: Vec<u32>,
+    /// Records to be woken rather than take the strike, in ascending order.
+    pub waking: Vec<u32>,
     /// The new state, real part.
     pub out_re: Vec<f32>,
     /// The new state, imaginary part.
     pub out_im: Vec<f32>,
     /// The new power in dB.
     pub out_db: Vec<f32>,
-    /// Bound on the power until the pulses under way end, in dB.
-    pub out_peak_db: Vec<f32>,
 }
 
 impl AbsorbScratch {
@@ -53,13 +49,11 @@ impl AbsorbScratch {
             im: vec![0.0; n],
             add_re: vec![0.0; n],
             add_im: vec![0.0; n],
-            cap: vec![0.0; n],
-            reach: vec![0.0; n],
             record: vec![0; n],
+            waking: vec![0; n],
             out_re: vec![0.0; n],
             out_im: vec![0.0; n],
             out_db: vec![0.0; n],
-            out_peak_db: vec![0.0; n],
         }
     }
 
@@ -85,16 +79,13 @@ fn run_avx2(s: &mut AbsorbScratch, n: usize) {
 
 /// The state `g (re + i im) e^(i phase) + add`, with `g = e^log_gain`: what
 /// [`super::dormant::Dormant::state`] gives, rounded to `f32` as there, plus the pulse (`g`
-/// from [`exp_series`], within a unit in the last place of `f64::exp`); and the bound on the
-/// power until the pulses end, `(min(|state|, cap) + reach)^2`.
+/// from [`exp_series`], within a unit in the last place of `f64::exp`).
 #[inline(always)]
 fn run(s: &mut AbsorbScratch, n: usize) {
     let (phase, log_gain) = (&s.phase[..n], &s.log_gain[..n]);
     let (re, im) = (&s.re[..n], &s.im[..n]);
     let (add_re, add_im) = (&s.add_re[..n], &s.add_im[..n]);
-    let (cap, reach) = (&s.cap[..n], &s.reach[..n]);
     let (out_re, out_im, out_db) = (&mut s.out_re[..n], &mut s.out_im[..n], &mut s.out_db[..n]);
-    let out_peak_db = &mut s.out_peak_db[..n];
     for k in 0..n {
         // Sine and cosine of the phase from its half-angle about pi, as `Dormant::state` does.
         let h = 0.5 * (phase[k] - PI);
@@ -104,11 +95,6 @@ fn run(s: &mut AbsorbScratch, n: usize) {
         let (r, i) = (re[k] as f64, im[k] as f64);
         let state_re = (g * (r * cos - i * sin)) as f32;
         let state_im = (g * (r * sin + i * cos)) as f32;
-        let before = (state_re * state_re + state_im * state_im)
-            .sqrt()
-            .min(cap[k]);
-        let peak = before + reach[k];
-        out_peak_db[k] = power_to_db(peak * peak);
         let z_re = (state_re as f64 + add_re[k]) as f32;
         let z_im = (state_im as f64 + add_im[k]) as f32;
         // A pole decaying hundreds of nepers within the pulse overflows the pulse referred back

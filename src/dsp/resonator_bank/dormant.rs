@@ -61,11 +61,11 @@ pub(super) struct Dormant {
     /// ([`ResonatorBank::start_dormant`]), else `u64::MAX`: woken at that instant it has no
     /// ringing of its own to fade back in.
     pub rest_at: u64,
-    /// Bank clock at which the pulses it took analytically end: until then its state runs ahead
-    /// of the truth by what they have not played yet.
-    pub pulse_end: u64,
-    /// Bound on its power until `pulse_end`, in dB: its amplitude before the pulses plus all
-    /// they can add.
+    /// Samples after `at` until the pulses it took analytically end, if its level is to be
+    /// bounded until then (its state runs ahead of the truth by what they have not played yet).
+    pub pulse_left: u32,
+    /// Bound on its power until the pulses end, in dB: its amplitude before them plus all they
+    /// can add.
     pub pulse_peak_db: f32,
 }
 
@@ -89,7 +89,7 @@ impl Dormant {
         tag: 0,
         response: None,
         rest_at: u64::MAX,
-        pulse_end: 0,
+        pulse_left: 0,
         pulse_peak_db: f32::INFINITY,
     };
 
@@ -105,10 +105,12 @@ impl Dormant {
 
     /// Accumulates phase and decay up to bank clock `now`.
     pub fn advance_to(&mut self, now: u64) {
-        let n = now.saturating_sub(self.at) as f64;
+        let samples = now.saturating_sub(self.at);
+        let n = samples as f64;
         let phase = self.phase + self.theta * n;
         self.phase = phase - TAU * floor(phase * (1.0 / TAU));
         self.log_gain -= self.delta * n;
+        self.pulse_left = (self.pulse_left as u64).saturating_sub(samples) as u32;
         self.at = now;
     }
 
@@ -119,7 +121,7 @@ impl Dormant {
         let log_gain = self.log_gain - self.delta * t.saturating_sub(self.at) as f64;
         // 20 log10 of the amplitude: a neper of amplitude is DB_PER_NEPER dB.
         let level = self.snap_db + (DB_PER_NEPER as f64 * log_gain) as f32;
-        if t < self.pulse_end {
+        if t < self.at + self.pulse_left as u64 {
             level.min(self.pulse_peak_db)
         } else {
             level
@@ -242,7 +244,7 @@ impl ResonatorBank {
                 tag,
                 response: None,
                 rest_at: u64::MAX,
-                pulse_end: 0,
+                pulse_left: 0,
                 pulse_peak_db: f32::INFINITY,
             },
             recheck_at,

@@ -19,6 +19,7 @@
 use super::dormant::Dormant;
 use super::{ResonatorBank, NONE};
 use crate::dsp::coeffs::db_to_gain;
+use crate::dsp::masking::power_to_db;
 
 /// Most pulses kept track of at once (as many as one exciter overlaps).
 pub(super) const MAX_PULSES: usize = 4;
@@ -26,6 +27,11 @@ pub(super) const MAX_PULSES: usize = 4;
 /// Below this distance from 1 a geometric ratio is summed term by term rather than in closed
 /// form (the closed form divides by it).
 const NEAR_ONE: f64 = 1e-3;
+
+/// Least decay, in nepers, over what is left of the pulses under way for a dormant mode's level
+/// to be bounded until they end (3 dB): short of it, the record reads at most that much louder
+/// than the truth while they play, which only errs towards computing it.
+const BOUND_NEPERS: f64 = 0.35;
 
 /// Most decay, in nepers, over what is left of the pulses under way for a dormant mode to take
 /// a strike analytically: referred back to the strike the pulse grows by as much, and taking its
@@ -184,21 +190,6 @@ impl ResonatorBank {
                 kept += 1;
             }
         }
-        self.num_pulses = kept;
-        // Modes too damped to refer the pulses back to now are computed through them: woken
-        // before this pulse is noted (their old ringing, less what it has not played of the
-        // earlier pulses, fades back in), with this strike's gain.
-        for r in (0..self.num_dormant).rev() {
-            let d = &self.dormant[r];
-            if self.slot_of_mode[d.mode as usize] == NONE
-                && d.delta * span as f64 > MAX_ABSORB_NEPERS
-            {
-                let mode = d.mode as usize;
-                self.wake_record(r);
-                let slot = self.slot_of_mode[mode] as usize;
-                self.gain[slot] = gain_of(mode);
-            }
-        }
         if kept == MAX_PULSES {
             self.pulses.rotate_left(1);
             earlier.rotate_left(1);
@@ -214,11 +205,18 @@ impl ResonatorBank {
         let key = (pulse.shape, unit.samples());
         // Each record is brought to now and its share of the pulse worked out; the arithmetic
         // of the new states then runs over all of them at once.
+        // Modes too damped to refer the pulses back to now are computed through them instead.
+        let too_damped = MAX_ABSORB_NEPERS / span as f64;
         let scratch = &mut self.absorb;
-        let mut n = 0;
+        let (mut n, mut num_waking) = (0, 0);
         for r in 0..self.num_dormant {
             let d = &mut self.dormant[r];
             if self.slot_of_mode[d.mode as usize] != NONE {
+                continue;
+            }
+            if d.delta > too_damped {
+                scratch.waking[num_waking] = r as u32;
+                num_waking += 1;
                 continue;
             }
             d.advance_to(now);
@@ -247,19 +245,26 @@ impl ResonatorBank {
             scratch.im[n] = d.im;
             scratch.add_re[n] = added.re;
             scratch.add_im[n] = added.im;
-            // Its amplitude now is at most what bounded it through the earlier pulses.
-            scratch.cap[n] = if now < d.pulse_end {
-                db_to_gain(d.pulse_peak_db)
-            } else {
-                f32::INFINITY
-            };
-            scratch.reach[n] = gain.abs() * reach;
             scratch.record[n] = r as u32;
             n += 1;
+            // Referred back, the pulses make the record read up to `delta * span` nepers louder
+            // than the truth: beyond 3 dB it is read against a bound until they end, its
+            // amplitude now (at most what bounded it through the earlier pulses) and all the
+            // pulses can add.
+            if d.pulse_left > 0 || d.delta * span as f64 > BOUND_NEPERS {
+                let amplitude =
+                    (d.log_gain.exp() as f32 * d.re.hypot(d.im)).min(if d.pulse_left > 0 {
+                        db_to_gain(d.pulse_peak_db)
+                    } else {
+                        f32::INFINITY
+                    });
+                let peak = amplitude + gain.abs() * reach;
+                d.pulse_peak_db = power_to_db(peak * peak);
+                d.pulse_left = span as u32;
+            }
             d.phase = 0.0;
             d.log_gain = 0.0;
             d.gain = gain;
-            d.pulse_end = now + span;
             if due {
                 self.recheck[r] = now;
             }
@@ -270,11 +275,22 @@ impl ResonatorBank {
             d.re = scratch.out_re[k];
             d.im = scratch.out_im[k];
             d.snap_db = scratch.out_db[k];
-            d.pulse_peak_db = scratch.out_peak_db[k];
         }
         if due {
             self.earliest_recheck = self.earliest_recheck.min(now);
         }
+        // Woken as though before this pulse (their old ringing, less what it has not played of
+        // the earlier pulses, fades back in), with this strike's gain; last first, so the
+        // records moved into the places of those woken have been passed already.
+        self.num_pulses = kept;
+        for k in (0..num_waking).rev() {
+            let r = self.absorb.waking[k] as usize;
+            let mode = self.dormant[r].mode as usize;
+            self.wake_record(r);
+            let slot = self.slot_of_mode[mode] as usize;
+            self.gain[slot] = gain_of(mode);
+        }
+        self.num_pulses = kept + 1;
         n
     }
 
