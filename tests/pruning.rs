@@ -852,3 +852,22 @@ fn a_masker_voice_taking_a_new_note_between_analyses_unmasks_at_the_next_one() {
     play(&mut e, &renote, frame);
     assert_eq!(e.stats().dormant_modes, 0, "still masked by a note gone");
 }
+
+#[test]
+fn raising_the_truncation_threshold_drops_dormant_modes_under_it_at_the_next_analysis() {
+    // The 15 kHz mode, 80 dB down, sits dormant under the threshold in quiet, which the
+    // analyses pass over until it is due. Raised over it, the truncation threshold drops it at
+    // once.
+    let bank = simple_bank(&[(1_000.0, 1.0, 1.0), (15_000.0, 0.5, 1e-4)]);
+    let mut e = pruned_engine(&bank);
+    strike(&mut e, 0.1);
+    assert_eq!(switched_off(&e), vec![mode_at(&e, 15_000.0)]);
+    let dropped = e.pruning_stats().dropped;
+    let mut c = e.controls().clone();
+    c.truncation_db = -60.0;
+    e.set_controls(&c);
+    let samples = 2 * frame(&e);
+    play(&mut e, &[], samples);
+    assert!(switched_off(&e).is_empty(), "still dormant");
+    assert_eq!(e.pruning_stats().dropped, dropped + 1);
+}

@@ -13,7 +13,8 @@
 //! rows the kernels run over and its state is carried analytically ([`dormant`]), so it can come
 //! back in phase. Switching off and on fades the mode's output through its pole, at no cost per
 //! sample. A mode woken by a strike computes the strike from rest at once, while its old ringing
-//! fades back in beside it in a *ghost* slot that ignores input, and joins it when the fade ends.
+//! fades back in beside it in a *ghost* slot that ignores input, and joins it when the fade ends
+//! (a mode the strike itself started has no old ringing, and no ghost).
 
 mod absorb;
 mod dormant;
@@ -107,7 +108,7 @@ pub struct ResonatorBank {
     dormant_of_mode: Vec<u32>,
     /// Number of modes fading out: they have both a slot and a record.
     num_fading_out: usize,
-    /// Modes brought back by `wake_all`, ever.
+    /// Modes brought back with old ringing to fade in beside them (a ghost), ever.
     woken: u64,
     /// Mode-samples the kernels have computed, ever (row padding included).
     computed: u64,

@@ -86,9 +86,11 @@ pub struct PruningStats {
     pub switched_on: u64,
     /// Dormant modes dropped for good below the truncation threshold.
     pub dropped: u64,
-    /// Dormant or fading modes woken by strikes and input.
+    /// Dormant or fading modes woken by strikes and input, with old ringing to fade back in (not
+    /// modes a strike started from rest and woke at once).
     pub woken: u64,
-    /// Dormant modes that took a strike analytically.
+    /// Dormant modes that took a strike analytically, modes the strike started from rest among
+    /// them.
     pub absorbed: u64,
     /// Nanoseconds spent in the analyses, measured only while profiling is on
     /// ([`Engine::set_profiling`]).
@@ -188,8 +190,9 @@ pub(super) struct Pruner {
     /// Whether the next control tick is to analyse: the input has woken modes, or a strike
     /// came under a budget.
     pending: bool,
-    /// The settings the last full look ran with: a change looks at everything again.
-    settings: Option<(f32, bool, Option<usize>)>,
+    /// The settings the last full look ran with (masking offset, pruning, budget, truncation): a
+    /// change looks at everything again.
+    settings: Option<(f32, bool, Option<usize>, f32)>,
     /// Calibration (dB SPL of a unit amplitude at the output) of the last full look.
     calibration_db: f32,
     /// Whether analyses and strikes are timed.

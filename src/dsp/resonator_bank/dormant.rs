@@ -186,7 +186,8 @@ impl ResonatorBank {
         self.num_fading
     }
 
-    /// Modes brought back by [`ResonatorBank::wake_all`] since the bank was made.
+    /// Modes woken with old ringing to fade back in beside them (a ghost) since the bank was
+    /// made: by strikes and input, not counting modes a strike started and woke at once.
     pub fn num_woken(&self) -> u64 {
         self.woken
     }

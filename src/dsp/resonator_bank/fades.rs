@@ -141,7 +141,8 @@ impl ResonatorBank {
     }
 
     /// Wakes dormant `mode` (not one fading out; see [`ResonatorBank::wake_fading`]): it computes
-    /// from rest beside a ghost that fades its ringing back in.
+    /// from rest beside a ghost that fades its ringing back in. A mode started from rest at this
+    /// instant ([`ResonatorBank::start_dormant`]) has no ringing yet: it simply computes.
     pub fn wake(&mut self, mode: usize) {
         let r = self.dormant_of_mode[mode];
         if r != NONE && self.slot_of_mode[mode] == NONE {

@@ -476,8 +476,9 @@ mod strike {
     #[test]
     fn a_dormant_mode_reads_no_louder_than_a_pulse_under_way_can_make_it() {
         // Mode 0, at 30 Hz, decays 5 nepers over the 12.5 ms mallet: referred back to the strike,
-        // the pulse is some 25 dB louder than anything it can make the mode. Until the pulse ends its level
-        // reads at most its amplitude before plus the pulse's; from then on, its true level.
+        // the pulse is some 25 dB louder than anything it can make the mode. Until the pulse
+        // ends its level reads at most its amplitude before plus the pulse's; from then on, its
+        // true level.
         let pole = |m: usize| (TAU * [30.0, 900.0][m] / RATE, [5.0 / 600.0, 1e-4][m]);
         let mut reference = ResonatorBank::new(2);
         for m in 0..2 {

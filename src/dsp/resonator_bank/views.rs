@@ -37,8 +37,7 @@ pub struct DormantMode {
     pub recheck_at: u64,
     /// The pruner's note.
     pub tag: u32,
-    /// Whether it started from rest at this instant ([`ResonatorBank::start_dormant`]) and has
-    /// not been looked at yet.
+    /// Whether it started from rest at this instant ([`ResonatorBank::start_dormant`]).
     pub from_rest: bool,
 }
 

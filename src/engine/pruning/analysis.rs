@@ -52,7 +52,7 @@ impl Engine {
         let (rate, now) = (*sample_rate_hz, *clock);
         p.pending = false;
         p.stats.analyses += 1;
-        let settings = (c.masking_offset_db, c.pruning, cap);
+        let settings = (c.masking_offset_db, c.pruning, cap, c.truncation_db);
         // A new calibration or setting changes every verdict (levels drift a little with the
         // output gain's smoothing first).
         let recheck_all =

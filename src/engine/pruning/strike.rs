@@ -6,10 +6,15 @@
 //! ([`crate::dsp::ResonatorBank::absorb_strike`]) and its level afterwards is known exactly. Most
 //! stay under what kept them off (the masking curve over them, falling as its masker decays, or
 //! the threshold in quiet), and stay dormant: a comparison each. The few lifted above it, and the
-//! modes started, are judged by the masking pass, against the maskers carried over from the last analysis and the
-//! voice's own computed modes as the strike leaves them; those found audible are woken at the
-//! strike's exact sample and compute it from its first sample, their old ringing fading back in
-//! beside them. A noise burst is not known in advance: it wakes them all.
+//! modes started, are judged by the masking pass, against the maskers carried over from the last
+//! analysis and the voice's own computed modes as the strike leaves them; those found audible are
+//! woken at the strike's exact sample and compute it from its first sample, their old ringing (a
+//! mode started by the strike has none) fading back in beside them. Modes decaying too fast to
+//! take the pulse analytically are computed through it. A noise burst is not known in advance: it
+//! wakes them all.
+//!
+//! A voice that has taken a new note or tuning since the last analysis is judged as it is now:
+//! its generation moves on at the strike, and the next analysis looks again at what it masked.
 //!
 //! Under a budget, only as many are woken as the budget would keep, ranked by energy with the
 //! modes computed now and not fading out; the next control tick ranks everything again. With the
