@@ -253,7 +253,8 @@ impl ResonatorBank {
         slot
     }
 
-    /// Sets the input gain of every live mode to `gain_of(mode)`.
+    /// Sets the input gain of every computed mode to `gain_of(mode)` (dormant modes take theirs
+    /// with the strike, [`ResonatorBank::absorb_strike`]).
     pub fn set_gains_with(&mut self, mut gain_of: impl FnMut(usize) -> f32) {
         for slot in self.live_slots() {
             let entry = self.mode_of_slot[slot];

@@ -194,10 +194,11 @@ impl Voice {
     }
 
     /// Strikes the voice: restarts modes that have died (unless the strike cannot lift them above
-    /// `threshold`), sets every mode's gain to `gains` (the bank's at the strike point), tunes the
-    /// voice to `tuning` and starts the pulse. With `start_dormant` (pruning on, a pulse known in
-    /// advance) the modes restarted are not computed until the pruner hears them: they start
-    /// dormant, for [`crate::engine::Engine`]'s `settle_strike` to judge at once.
+    /// `threshold`), sets every computed mode's gain to `gains` (the bank's at the strike point;
+    /// dormant ones take theirs with the pulse, in `settle_strike`), tunes the voice to `tuning`
+    /// and starts the pulse. With `start_dormant` (pruning on, a pulse known in advance) the
+    /// modes restarted are not computed until the pruner hears them: they start dormant, for
+    /// [`crate::engine::Engine`]'s `settle_strike` to judge at once.
     #[allow(clippy::too_many_arguments)] // two call sites; the values are all distinct and plain
     pub fn strike(
         &mut self,

@@ -27,7 +27,8 @@ pub(super) struct Dormant {
     pub mode: u32,
     /// Its accumulator column, where it returns.
     pub column: u32,
-    /// Its input gain.
+    /// The gain what is left of the pulses under way reaches it with, as the latest strike set
+    /// the computed modes' (zero for a mode started from rest until its strike comes).
     pub gain: f32,
     /// Samples it fades over, in and out.
     pub fade_len: u32,
@@ -114,18 +115,17 @@ impl Dormant {
         self.at = now;
     }
 
-    /// Power `|z|^2` in dB at bank clock `t` (not before `at`); while the pulses it took play
-    /// (when its state runs ahead of the truth), at most their bound.
+    /// Power `|z|^2` in dB at bank clock `t` (not before `at`). While the pulses it took with a
+    /// bound play, its state runs ahead of the truth (louder, or quieter where what they have
+    /// still to play works against its ringing): their bound instead.
     #[inline]
     pub fn level_db_at(&self, t: u64) -> f32 {
+        if t < self.at + self.pulse_left as u64 {
+            return self.pulse_peak_db;
+        }
         let log_gain = self.log_gain - self.delta * t.saturating_sub(self.at) as f64;
         // 20 log10 of the amplitude: a neper of amplitude is DB_PER_NEPER dB.
-        let level = self.snap_db + (DB_PER_NEPER as f64 * log_gain) as f32;
-        if t < self.at + self.pulse_left as u64 {
-            level.min(self.pulse_peak_db)
-        } else {
-            level
-        }
+        self.snap_db + (DB_PER_NEPER as f64 * log_gain) as f32
     }
 
     /// Power `|z|^2` at bank clock `t` (not before `at`).
@@ -197,6 +197,7 @@ impl ResonatorBank {
     pub fn set_recheck(&mut self, mode: usize, recheck_at: u64, tag: u32) {
         let r = self.dormant_of_mode[mode];
         if r != NONE {
+            let recheck_at = self.by_pulse_end(r as usize, recheck_at);
             self.recheck[r as usize] = recheck_at;
             self.dormant[r as usize].tag = tag;
             self.earliest_recheck = self.earliest_recheck.min(recheck_at);
@@ -208,8 +209,21 @@ impl ResonatorBank {
     pub fn set_recheck_time(&mut self, mode: usize, recheck_at: u64) {
         let r = self.dormant_of_mode[mode];
         if r != NONE {
+            let recheck_at = self.by_pulse_end(r as usize, recheck_at);
             self.recheck[r as usize] = recheck_at;
             self.earliest_recheck = self.earliest_recheck.min(recheck_at);
+        }
+    }
+
+    /// `recheck_at`, or the end of the pulses record `r` reads a bound through if sooner: its
+    /// level then jumps back to the truth, which a time worked out from the bound misses.
+    fn by_pulse_end(&self, r: usize, recheck_at: u64) -> u64 {
+        let d = &self.dormant[r];
+        let end = d.at + d.pulse_left as u64;
+        if end > self.clock {
+            recheck_at.min(end)
+        } else {
+            recheck_at
         }
     }
 

@@ -18,7 +18,6 @@
 
 use super::dormant::Dormant;
 use super::{ResonatorBank, NONE};
-use crate::dsp::coeffs::db_to_gain;
 use crate::dsp::masking::power_to_db;
 
 /// Most pulses kept track of at once (as many as one exciter overlaps).
@@ -28,9 +27,9 @@ pub(super) const MAX_PULSES: usize = 4;
 /// form (the closed form divides by it).
 const NEAR_ONE: f64 = 1e-3;
 
-/// Least decay, in nepers, over what is left of the pulses under way for a dormant mode's level
-/// to be bounded until they end (3 dB): short of it, the record reads at most that much louder
-/// than the truth while they play, which only errs towards computing it.
+/// Least decay, in nepers, over what is left of the pulses under way for a dormant mode to read
+/// a bound until they end (3 dB): short of it, the record reads within about that much of the
+/// truth while they play.
 const BOUND_NEPERS: f64 = 0.35;
 
 /// Most decay, in nepers, over what is left of the pulses under way for a dormant mode to take
@@ -247,18 +246,18 @@ impl ResonatorBank {
             scratch.add_im[n] = added.im;
             scratch.record[n] = r as u32;
             n += 1;
-            // Referred back, the pulses make the record read up to `delta * span` nepers louder
-            // than the truth: beyond 3 dB it is read against a bound until they end, its
-            // amplitude now (at most what bounded it through the earlier pulses) and all the
-            // pulses can add.
+            // Referred back, the pulses make the record read up to `delta * span` nepers off the
+            // truth: beyond 3 dB it reads a bound until they end instead, its true
+            // amplitude now (the record less what the earlier pulses have still to play, at its
+            // gain so far) and all the pulses can add.
             if d.pulse_left > 0 || d.delta * span as f64 > BOUND_NEPERS {
-                let amplitude =
-                    (d.log_gain.exp() as f32 * d.re.hypot(d.im)).min(if d.pulse_left > 0 {
-                        db_to_gain(d.pulse_peak_db)
-                    } else {
-                        f32::INFINITY
-                    });
-                let peak = amplitude + gain.abs() * reach;
+                let (re, im) = d.state();
+                let mut truth = C::new(re as f64, im as f64);
+                for &(played, old) in &earlier[..kept] {
+                    let rest = p.powi(played).mul(old.response(p, played, u32::MAX));
+                    truth = truth.sub(rest.scale(d.gain as f64));
+                }
+                let peak = truth.norm_sqr().sqrt() as f32 + gain.abs() * reach;
                 d.pulse_peak_db = power_to_db(peak * peak);
                 d.pulse_left = span as u32;
             }

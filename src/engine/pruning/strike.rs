@@ -3,9 +3,10 @@
 //! The strike is known in full when it comes (an impulse or a mallet pulse of known area and
 //! length), so every dormant mode of the struck voice, and every mode it starts from rest (they
 //! start dormant, with no reason yet to be off), takes it analytically
-//! ([`crate::dsp::ResonatorBank::absorb_strike`]) and its level afterwards is known exactly. Most
-//! stay under what kept them off (the masking curve over them, falling as its masker decays, or
-//! the threshold in quiet), and stay dormant: a comparison each. The few lifted above it, and the
+//! ([`crate::dsp::ResonatorBank::absorb_strike`]) and its level afterwards is known (exactly, or
+//! through a long pulse on a fast-decaying mode, as a bound until the pulse ends). Most stay
+//! under what kept them off (the masking curve over them, falling as its masker decays, or the
+//! threshold in quiet), and stay dormant: a comparison each. The few lifted above it, and the
 //! modes started, are judged by the masking pass, against the maskers carried over from the last
 //! analysis and the voice's own computed modes as the strike leaves them; those found audible are
 //! woken at the strike's exact sample and compute it from its first sample, their old ringing (a
