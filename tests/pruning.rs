@@ -871,3 +871,52 @@ fn raising_the_truncation_threshold_drops_dormant_modes_under_it_at_the_next_ana
     assert!(switched_off(&e).is_empty(), "still dormant");
     assert_eq!(e.pruning_stats().dropped, dropped + 1);
 }
+
+#[test]
+fn a_mode_a_second_strike_starts_within_the_first_pulse_takes_the_rest_of_it() {
+    // The 216 Hz mode, 50 dB under the 200 Hz one, is silent at position a and sounds at b. A
+    // 4 ms mallet at a on the ringing voice, then one at b a control period later: the second
+    // starts it dormant (masked), and it takes what is left of the first pulse at its new gain,
+    // as a computed mode does.
+    let mut bank = Bank::new("test", two_ends());
+    let mode = |freq_hz, gains: [f64; 2]| Mode {
+        freq_hz,
+        decay_per_s: 1.0,
+        gains: gains.to_vec(),
+    };
+    bank.modes = vec![mode(200.0, [1.0, 1.0]), mode(216.0, [0.0, 0.003])];
+    let played = |pruning: bool| {
+        let mut e = pruned_engine(&bank);
+        let mut c = e.controls().clone();
+        c.exciter = ExciterKind::Mallet;
+        c.hardness_ms = 4.0;
+        c.velocity_to_hardness = 0.0;
+        c.position_variation = 0.0;
+        c.strike_x = 0.0;
+        c.pruning = pruning;
+        e.set_controls(&c);
+        let key = root(&e);
+        // The second strike at a finds the loud mode ringing and starts nothing dormant.
+        play(&mut e, &[on(0, key, 1.0)], 10 * CONTROL_PERIOD);
+        assert_eq!(e.stats().dormant_modes, 0);
+        play(&mut e, &[on(0, key, 1.0)], CONTROL_PERIOD);
+        c.strike_x = 1.0;
+        e.set_controls(&c);
+        play(&mut e, &[on(0, key, 1.0)], 20 * CONTROL_PERIOD);
+        e
+    };
+    let (pruned, full) = (played(true), played(false));
+    let quiet = mode_at(&pruned, 216.0);
+    assert_eq!(switched_off(&pruned), vec![quiet]);
+    let energy = |e: &Engine| {
+        let mut energy = None;
+        e.visit_mode_energies(|m, x| {
+            if m == quiet {
+                energy = Some(x);
+            }
+        });
+        energy.expect("the quiet mode sounds")
+    };
+    let (got, want) = (energy(&pruned), energy(&full));
+    assert!((got - want).abs() <= 1e-3 * want, "{got} against {want}");
+}

@@ -447,7 +447,8 @@ impl Engine {
             threshold,
             start_dormant,
         );
-        if self.voices[i].modes.num_dormant() > 0 {
+        // With pruning, every pulse is noted: modes a later strike starts dormant take the rest.
+        if start_dormant || self.voices[i].modes.num_dormant() > 0 {
             self.settle_strike(i, kind, amplitude, len);
         }
     }

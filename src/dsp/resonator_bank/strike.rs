@@ -162,16 +162,15 @@ impl ResonatorBank {
     /// `due`, each is due for another look by the pruner now; otherwise its recheck time stands
     /// until the pruner sets another from the strike's outcome. A mode the pruner then wakes
     /// ([`ResonatorBank::wake`]) computes the strike from its first sample. Modes decaying too
-    /// fast to take it analytically are woken at once. Returns how many took it.
+    /// fast to take it analytically are woken at once. Returns how many took it. Call it for
+    /// every pulse while pruning, dormant modes or not: modes started dormant later take the
+    /// rest of those still playing.
     pub fn absorb_strike(
         &mut self,
         pulse: Pulse,
         due: bool,
         mut gain_of: impl FnMut(usize) -> f32,
     ) -> usize {
-        if self.num_dormant == 0 {
-            return 0;
-        }
         let now = self.clock;
         // Forget pulses that have ended; what is left of the others, and for how long.
         let mut kept = 0;
@@ -196,6 +195,11 @@ impl ResonatorBank {
         }
         self.pulses[kept] = (now, pulse);
         self.num_pulses = kept + 1;
+        // Noted even with no dormant modes: a mode this pulse is still playing into when a later
+        // strike starts it dormant takes the rest of it.
+        if self.num_dormant == 0 {
+            return 0;
+        }
         let unit = Pulse {
             amplitude: 1.0,
             ..pulse

@@ -78,9 +78,6 @@ impl Engine {
             ExciterKind::Noise => return,
         };
         let start = self.pruner.profiling.then(Instant::now);
-        // Dormant modes are left whatever comes of it: the analyses must go on even if pruning
-        // and the budget are turned off before the next one, to bring them back.
-        self.pruner.engaged = true;
         let pulse = Pulse {
             shape,
             amplitude,
@@ -88,16 +85,21 @@ impl Engine {
         };
         let gains = &self.strike_gains;
         let modes = &mut self.voices[i].modes;
-        let bound = amplitude * kind.peak_bound(len);
-        let cap = self.budget.cap(&self.controls, self.sample_rate_hz);
         // With pruning the modes are judged below; with a budget alone, ranked by energy;
         // otherwise the next analysis looks at them.
         let pruning = self.controls.pruning;
         self.pruner.stats.absorbed += modes.absorb_strike(pulse, !pruning, |m| gains[m]) as u64;
-        if pruning {
-            self.judge_struck(i, bound, cap);
-        } else if let Some(cap) = cap {
-            self.wake_within_budget(i, bound, cap);
+        if modes.num_dormant() > 0 {
+            // Dormant modes are left whatever comes of it: the analyses must go on even if
+            // pruning and the budget are turned off before the next one, to bring them back.
+            self.pruner.engaged = true;
+            let bound = amplitude * kind.peak_bound(len);
+            let cap = self.budget.cap(&self.controls, self.sample_rate_hz);
+            if pruning {
+                self.judge_struck(i, bound, cap);
+            } else if let Some(cap) = cap {
+                self.wake_within_budget(i, bound, cap);
+            }
         }
         if let Some(start) = start {
             self.pruner.stats.strike_ns += start.elapsed().as_nanos() as u64;
