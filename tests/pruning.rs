@@ -872,12 +872,12 @@ fn raising_the_truncation_threshold_drops_dormant_modes_under_it_at_the_next_ana
     assert_eq!(e.pruning_stats().dropped, dropped + 1);
 }
 
-#[test]
-fn a_mode_a_second_strike_starts_within_the_first_pulse_takes_the_rest_of_it() {
-    // The 216 Hz mode, 50 dB under the 200 Hz one, is silent at position a and sounds at b. A
-    // 4 ms mallet at a on the ringing voice, then one at b a control period later: the second
-    // starts it dormant (masked), and it takes what is left of the first pulse at its new gain,
-    // as a computed mode does.
+/// The 216 Hz mode of a two-mode bank, 50 dB under the 200 Hz one, is silent at position a and
+/// sounds at b. A strike of `first` at a on the ringing voice (which starts nothing), then a 4 ms
+/// mallet at b a control period later, within the first: returns the quiet mode's energy 20
+/// control periods on, with pruning and without, and whether it was computed at any time
+/// after the second strike.
+fn quiet_mode_after_overlapping_strikes(first: ExciterKind) -> (f32, f32, bool) {
     let mut bank = Bank::new("test", two_ends());
     let mode = |freq_hz, gains: [f64; 2]| Mode {
         freq_hz,
@@ -896,27 +896,58 @@ fn a_mode_a_second_strike_starts_within_the_first_pulse_takes_the_rest_of_it() {
         c.pruning = pruning;
         e.set_controls(&c);
         let key = root(&e);
-        // The second strike at a finds the loud mode ringing and starts nothing dormant.
         play(&mut e, &[on(0, key, 1.0)], 10 * CONTROL_PERIOD);
         assert_eq!(e.stats().dormant_modes, 0);
+        c.exciter = first;
+        e.set_controls(&c);
         play(&mut e, &[on(0, key, 1.0)], CONTROL_PERIOD);
+        assert_eq!(
+            e.stats().dormant_modes,
+            0,
+            "the first strike starts nothing"
+        );
+        let before = e.pruning_stats();
+        c.exciter = ExciterKind::Mallet;
         c.strike_x = 1.0;
         e.set_controls(&c);
-        play(&mut e, &[on(0, key, 1.0)], 20 * CONTROL_PERIOD);
-        e
-    };
-    let (pruned, full) = (played(true), played(false));
-    let quiet = mode_at(&pruned, 216.0);
-    assert_eq!(switched_off(&pruned), vec![quiet]);
-    let energy = |e: &Engine| {
+        let mut computed = false;
+        for k in 0..20 {
+            let events = if k == 0 {
+                vec![on(0, key, 1.0)]
+            } else {
+                vec![]
+            };
+            play(&mut e, &events, CONTROL_PERIOD);
+            computed |= !switched_off(&e).contains(&mode_at(&e, 216.0));
+        }
+        let after = e.pruning_stats();
+        computed |= (after.woken, after.switched_on) != (before.woken, before.switched_on);
+        let quiet = mode_at(&e, 216.0);
         let mut energy = None;
         e.visit_mode_energies(|m, x| {
             if m == quiet {
                 energy = Some(x);
             }
         });
-        energy.expect("the quiet mode sounds")
+        (energy.expect("the quiet mode sounds"), computed)
     };
-    let (got, want) = (energy(&pruned), energy(&full));
+    let ((pruned, computed), (full, _)) = (played(true), played(false));
+    (pruned, full, computed)
+}
+
+#[test]
+fn a_mode_a_second_strike_starts_within_the_first_pulse_takes_the_rest_of_it() {
+    // The second strike starts the quiet mode dormant (masked), and it takes what is left of
+    // the first pulse at its new gain, as a computed mode does.
+    let (got, want, computed) = quiet_mode_after_overlapping_strikes(ExciterKind::Mallet);
+    assert!(!computed, "the quiet mode stays dormant");
+    assert!((got - want).abs() <= 1e-3 * want, "{got} against {want}");
+}
+
+#[test]
+fn a_mode_a_strike_starts_within_a_noise_burst_takes_the_rest_of_it() {
+    // A noise burst is not known in advance, so nothing can take it analytically: the mallet
+    // within it starts the quiet mode computed, and it takes the rest of the burst.
+    let (got, want, _) = quiet_mode_after_overlapping_strikes(ExciterKind::Noise);
     assert!((got - want).abs() <= 1e-3 * want, "{got} against {want}");
 }

@@ -113,6 +113,11 @@ impl Exciter {
         self.count == 0
     }
 
+    /// How many strikes are under way.
+    pub fn num_under_way(&self) -> usize {
+        self.count
+    }
+
     /// Bound on how much the strikes still under way can add to a mode's amplitude, relative to
     /// its gain: the sum of their whole pulses' bounds ([`ExciterKind::peak_bound`]).
     pub fn pending_bound(&self) -> f32 {

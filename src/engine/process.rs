@@ -432,8 +432,13 @@ impl Engine {
             .max(1.0) as u32;
         let threshold = db_to_gain(c.truncation_db);
         let kind = c.exciter;
-        // With pruning, modes the strike restarts are judged before they are computed.
-        let start_dormant = c.pruning && kind != ExciterKind::Noise;
+        // With pruning, modes the strike restarts are judged before they are computed. Started
+        // dormant, they take only the pulses their bank knows of: while a strike it does not know
+        // still plays (a noise burst, or one struck with pruning off), they are computed.
+        let v = &self.voices[i];
+        let start_dormant = c.pruning
+            && kind != ExciterKind::Noise
+            && v.exciter.num_under_way() == v.modes.num_pulses_under_way();
         self.prepare_strike(i, kind);
         self.voices[i].strike(
             &self.bank,
@@ -447,7 +452,8 @@ impl Engine {
             threshold,
             start_dormant,
         );
-        // With pruning, every pulse is noted: modes a later strike starts dormant take the rest.
+        // Pulses are noted whenever modes may start dormant, so those a later strike starts
+        // within one take the rest of it.
         if start_dormant || self.voices[i].modes.num_dormant() > 0 {
             self.settle_strike(i, kind, amplitude, len);
         }

@@ -163,8 +163,9 @@ impl ResonatorBank {
     /// until the pruner sets another from the strike's outcome. A mode the pruner then wakes
     /// ([`ResonatorBank::wake`]) computes the strike from its first sample. Modes decaying too
     /// fast to take it analytically are woken at once. Returns how many took it. Call it for
-    /// every pulse while pruning, dormant modes or not: modes started dormant later take the
-    /// rest of those still playing.
+    /// every pulse within which modes may start dormant, dormant modes or not: those started
+    /// later take the rest of the pulses still playing
+    /// ([`ResonatorBank::num_pulses_under_way`]).
     pub fn absorb_strike(
         &mut self,
         pulse: Pulse,
@@ -295,6 +296,14 @@ impl ResonatorBank {
         }
         self.num_pulses = kept + 1;
         n
+    }
+
+    /// How many of the pulses given to [`ResonatorBank::absorb_strike`] are still playing.
+    pub fn num_pulses_under_way(&self) -> usize {
+        self.pulses[..self.num_pulses]
+            .iter()
+            .filter(|(start, pulse)| start + pulse.samples() as u64 > self.clock)
+            .count()
     }
 
     /// The state of record `d` (brought to now) with the unplayed part of any pulse it took
