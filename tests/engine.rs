@@ -325,6 +325,50 @@ fn strike_position_selects_the_gain_column() {
 }
 
 #[test]
+fn a_restrike_that_starts_new_modes_plays_them_at_the_voice_pitch() {
+    // Mode 1 sounds only at position a, mode 2 only at b. Struck at a, then at b on the same
+    // ringing key (the voice's tuning unchanged): the second strike starts mode 2 alone, and
+    // the output is the sum of the two strikes played on their own.
+    let mut bank = simple_bank(&[(300.0, 2.0, 1.0), (1_700.0, 2.0, 0.0)]);
+    bank.positions.push(modal_resonator::model::Position {
+        name: "b".into(),
+        coords: vec![1.0],
+    });
+    bank.modes[0].gains.push(0.0);
+    bank.modes[1].gains.push(1.0);
+    for pruning in [false, true] {
+        let played = |at_a: bool, at_b: bool| {
+            let mut e = engine(&bank, RATE);
+            let mut c = e.controls().clone();
+            c.exciter = modal_resonator::dsp::ExciterKind::Impulse;
+            c.position_variation = 0.0;
+            c.pruning = pruning;
+            c.strike_x = 0.0;
+            e.set_controls(&c);
+            let strike = |on_: bool| if on_ { vec![on(0, 60, 1.0)] } else { vec![] };
+            let (mut l, _) = render(&mut e, &strike(at_a), 0.05, 64);
+            c.strike_x = 1.0;
+            e.set_controls(&c);
+            let (second, _) = render(&mut e, &strike(at_b), 0.1, 64);
+            l.extend(second);
+            l
+        };
+        let (both, a, b) = (played(true, true), played(true, false), played(false, true));
+        assert!(peak(&b) > 0.01, "pruning {pruning}: mode 2 sounds");
+        let error = both
+            .iter()
+            .zip(a.iter().zip(&b))
+            .map(|(x, (y, z))| (x - y - z).abs())
+            .fold(0.0f32, f32::max);
+        assert!(
+            error <= 1e-5 * peak(&both),
+            "pruning {pruning}: off by {error} (peak {})",
+            peak(&both)
+        );
+    }
+}
+
+#[test]
 fn velocity_sets_force_and_hardness() {
     let bank = dense_bank(200, 100.0);
     let level = |velocity: f32| {
