@@ -304,9 +304,8 @@ fn modes_above_the_limit_are_not_played() {
     assert_eq!(e.stats().live_modes, 2);
 }
 
-#[test]
-fn strike_position_selects_the_gain_column() {
-    // Mode 1 is silent at the first position, mode 2 at the second.
+/// Two modes, 300 Hz sounding only at position a (x = 0), 1.7 kHz only at b (x = 1).
+fn a_mode_per_position() -> modal_resonator::model::Bank {
     let mut bank = simple_bank(&[(300.0, 2.0, 1.0), (1_700.0, 2.0, 0.0)]);
     bank.positions.push(modal_resonator::model::Position {
         name: "b".into(),
@@ -314,6 +313,12 @@ fn strike_position_selects_the_gain_column() {
     });
     bank.modes[0].gains.push(0.0);
     bank.modes[1].gains.push(1.0);
+    bank
+}
+
+#[test]
+fn strike_position_selects_the_gain_column() {
+    let bank = a_mode_per_position();
     for (x, want_live) in [(0.0f32, 1usize), (1.0, 1), (0.5, 2)] {
         let mut e = engine(&bank, RATE);
         let mut c = e.controls().clone();
@@ -326,16 +331,10 @@ fn strike_position_selects_the_gain_column() {
 
 #[test]
 fn a_restrike_that_starts_new_modes_plays_them_at_the_voice_pitch() {
-    // Mode 1 sounds only at position a, mode 2 only at b. Struck at a, then at b on the same
-    // ringing key (the voice's tuning unchanged): the second strike starts mode 2 alone, and
-    // the output is the sum of the two strikes played on their own.
-    let mut bank = simple_bank(&[(300.0, 2.0, 1.0), (1_700.0, 2.0, 0.0)]);
-    bank.positions.push(modal_resonator::model::Position {
-        name: "b".into(),
-        coords: vec![1.0],
-    });
-    bank.modes[0].gains.push(0.0);
-    bank.modes[1].gains.push(1.0);
+    // Struck at a, then at b on the same ringing key (the voice's tuning unchanged): the
+    // second strike starts the 1.7 kHz mode alone, and the output is the sum of the two
+    // strikes played on their own.
+    let bank = a_mode_per_position();
     for pruning in [false, true] {
         let played = |at_a: bool, at_b: bool| {
             let mut e = engine(&bank, RATE);
@@ -354,7 +353,10 @@ fn a_restrike_that_starts_new_modes_plays_them_at_the_voice_pitch() {
             l
         };
         let (both, a, b) = (played(true, true), played(true, false), played(false, true));
-        assert!(peak(&b) > 0.01, "pruning {pruning}: mode 2 sounds");
+        assert!(
+            peak(&b) > 0.01,
+            "pruning {pruning}: the 1.7 kHz mode sounds"
+        );
         let error = both
             .iter()
             .zip(a.iter().zip(&b))
