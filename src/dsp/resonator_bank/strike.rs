@@ -235,14 +235,17 @@ impl ResonatorBank {
                 }
             };
             let mut added = response.scale(pulse.amplitude as f64 * gain as f64);
-            // What is left of the earlier pulses now comes with this strike's gain.
             let change = gain as f64 - d.gain as f64;
-            if change != 0.0 {
+            let bounded = d.pulse_left > 0 || d.delta * span as f64 > BOUND_NEPERS;
+            // What the earlier pulses have still to play, at unit gain, referred back to now.
+            let mut rest = C::ZERO;
+            if change != 0.0 || bounded {
                 for &(played, old) in &earlier[..kept] {
-                    let rest = p.powi(played).mul(old.response(p, played, u32::MAX));
-                    added = added.add(rest.scale(change));
+                    rest = rest.add(p.powi(played).mul(old.response(p, played, u32::MAX)));
                 }
             }
+            // It now comes with this strike's gain.
+            added = added.add(rest.scale(change));
             scratch.phase[n] = d.phase;
             scratch.log_gain[n] = d.log_gain;
             scratch.re[n] = d.re;
@@ -255,13 +258,9 @@ impl ResonatorBank {
             // truth: beyond 3 dB it reads a bound until they end instead, its true
             // amplitude now (the record less what the earlier pulses have still to play, at its
             // gain so far) and all the pulses can add.
-            if d.pulse_left > 0 || d.delta * span as f64 > BOUND_NEPERS {
+            if bounded {
                 let (re, im) = d.state();
-                let mut truth = C::new(re as f64, im as f64);
-                for &(played, old) in &earlier[..kept] {
-                    let rest = p.powi(played).mul(old.response(p, played, u32::MAX));
-                    truth = truth.sub(rest.scale(d.gain as f64));
-                }
+                let truth = C::new(re as f64, im as f64).sub(rest.scale(d.gain as f64));
                 let peak = truth.norm_sqr().sqrt() as f32 + gain.abs() * reach;
                 d.pulse_peak_db = power_to_db(peak * peak);
                 d.pulse_left = span as u32;
