@@ -138,8 +138,9 @@ fn strike_input(len: usize) -> Vec<f32> {
 
 #[test]
 fn every_kernel_matches_the_scalar_oracle() {
-    // Mode counts that leave every size of group over after the whole ones.
-    for &n in &[1usize, 7, 30, 64, 96, 200, 420, 1000] {
+    // Mode counts that leave every size of group over after the whole ones (one to three rows,
+    // or row pairs).
+    for &n in &[1usize, 7, 14, 24, 30, 56, 64, 96, 200, 420, 1000] {
         let input = strike_input(24_000);
         let oracle = run(&mut assorted(n), Kernel::Scalar, &input, 64);
         let peak = oracle.iter().fold(0.0f64, |a, v| a.max(v.abs()));

@@ -69,7 +69,7 @@ pub struct ResonatorBank {
     /// Number of modes belonging to each column, computed or dormant: new modes go to the
     /// emptiest, so a column never holds more than its share.
     claimed: [u32; COLUMNS],
-    /// Rows handed to the kernel: the fullest column, rounded up to whole row blocks.
+    /// Rows the fullest column needs (the kernel takes them rounded up to its row block).
     rows_active: usize,
     /// Modes started since the bank was last cleared (counting restarts).
     num_started: usize,
@@ -180,7 +180,8 @@ impl ResonatorBank {
         self.num_slots - self.num_ghosts
     }
 
-    /// Number of modes the kernel advances per sample (live modes and ghosts plus padding).
+    /// Number of slots in the rows the fullest column needs: live modes and ghosts plus padding
+    /// (a kernel that takes two rows at once may advance one row more).
     pub fn num_computed(&self) -> usize {
         self.rows_active * COLUMNS
     }
@@ -286,7 +287,8 @@ impl ResonatorBank {
             self.refresh_coeffs();
         }
         self.clock += acc.len() as u64;
-        let n = self.rows_active * COLUMNS;
+        // Storage rows come in whole `ROW_BLOCK`s, and the rows past `rows_active` hold silence.
+        let n = self.rows_active.next_multiple_of(kernel.row_block()) * COLUMNS;
         self.computed += (n * acc.len()) as u64;
         kernels::process(
             kernel,
@@ -432,7 +434,7 @@ impl ResonatorBank {
             self.num_slots,
             self.live.iter().map(|&n| n as usize).sum::<usize>()
         );
-        self.rows_active = fullest.div_ceil(ROW_BLOCK) * ROW_BLOCK;
+        self.rows_active = fullest;
     }
 }
 

@@ -11,9 +11,9 @@
 //!   latency is hidden, state in registers for the whole run;
 //! - [`Kernel::Avx512`]: AVX-512, four 16-lane vectors (64 modes) in flight.
 //!
-//! All take `rows` as a multiple of [`ROW_BLOCK`] (two rows, one AVX-512 vector); rows after the
-//! last whole group go as a smaller group, so a bank with few modes sounding computes little
-//! padding.
+//! Each takes `rows` as a multiple of its [`Kernel::row_block`] (one row, or two for the kernels
+//! that advance two rows as one vector); rows after the last whole group go as a smaller group,
+//! so a bank with few modes sounding computes little padding.
 
 mod portable;
 mod scalar;
@@ -23,7 +23,7 @@ mod x86;
 /// Modes per row: one accumulator lane (and one stereo position) per column.
 pub const COLUMNS: usize = 8;
 
-/// Row counts handed to kernels are multiples of this: whole vectors for the widest kernel.
+/// Every kernel's [`Kernel::row_block`] divides this: storage comes in whole blocks of rows.
 pub const ROW_BLOCK: usize = 2;
 
 /// An implementation of the resonator recursion.
@@ -83,6 +83,15 @@ impl Kernel {
         }
     }
 
+    /// Row counts handed to this kernel are multiples of this: 2 where a vector (AVX-512) or a
+    /// group (portable) spans two rows, else 1.
+    pub const fn row_block(self) -> usize {
+        match self {
+            Kernel::Scalar | Kernel::Avx2 => 1,
+            Kernel::Portable | Kernel::Avx512 => 2,
+        }
+    }
+
     /// Whether this CPU can run the kernel.
     pub fn is_supported(self) -> bool {
         match self {
@@ -116,8 +125,8 @@ pub struct Rows<'a> {
 /// Advances every mode in `rows` over `acc.len()` samples, driven by `input` when given (same
 /// length as `acc`), adding each mode's output to `acc[n][column]`.
 ///
-/// Panics when the slices disagree in length, the row count is not a multiple of [`ROW_BLOCK`],
-/// or `kernel` is not supported by this CPU.
+/// Panics when the slices disagree in length, the row count is not a multiple of the kernel's
+/// [`Kernel::row_block`], or `kernel` is not supported by this CPU.
 pub fn process(kernel: Kernel, rows: Rows<'_>, input: Option<&[f32]>, acc: &mut [[f32; COLUMNS]]) {
     let len = rows.re.len();
     assert!(
@@ -127,10 +136,12 @@ pub fn process(kernel: Kernel, rows: Rows<'_>, input: Option<&[f32]>, acc: &mut 
             && rows.gain.len() == len,
         "resonator slices differ in length"
     );
+    let block = kernel.row_block();
     assert_eq!(
-        len % (COLUMNS * ROW_BLOCK),
+        len % (COLUMNS * block),
         0,
-        "rows must come in blocks of {ROW_BLOCK}"
+        "rows for the {} kernel must come in blocks of {block}",
+        kernel.name()
     );
     if let Some(x) = input {
         assert_eq!(x.len(), acc.len(), "input and accumulator lengths differ");

@@ -5,8 +5,8 @@
 
 use super::{Rows, COLUMNS};
 
-/// Rows advanced together (a row block, so no rows are left over).
-const GROUP: usize = super::ROW_BLOCK;
+/// Rows advanced together (the kernel's row block, so no rows are left over).
+const GROUP: usize = super::Kernel::Portable.row_block();
 const _: () = assert!(GROUP == 2, "the output sum below adds two rows");
 
 type Lanes = [[f32; COLUMNS]; GROUP];

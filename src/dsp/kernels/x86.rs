@@ -48,7 +48,7 @@ pub(super) unsafe fn process_avx2(
     let p = Ptrs::of(&mut rows);
     let mut start = 0;
     // SAFETY (all calls): `process` checked the slices share a length that is a whole number of
-    // row blocks (two rows, two vectors here), and each group stays within it.
+    // rows (one vector each here), and each group stays within it.
     unsafe {
         while start + 4 * W <= total {
             avx2_group::<4>(&p, start, input, acc);
@@ -56,7 +56,9 @@ pub(super) unsafe fn process_avx2(
         }
         match (total - start) / W {
             0 => {}
+            1 => avx2_group::<1>(&p, start, input, acc),
             2 => avx2_group::<2>(&p, start, input, acc),
+            3 => avx2_group::<3>(&p, start, input, acc),
             v => unreachable!("{v} vectors left over"),
         }
     }

@@ -42,7 +42,7 @@ fn repacking_keeps_each_mode_with_its_state() {
 #[test]
 fn retiring_finds_quiet_and_broken_modes_among_padding() {
     // 20 modes: columns 0-3 hold three, columns 4-7 two, so the rows the kernels run over hold
-    // 12 empty slots.
+    // 4 empty slots (12 for a kernel taking two rows at once).
     let mut bank = ResonatorBank::new(20);
     for m in 0..20 {
         bank.activate(m, coeffs(m), 1.0);
@@ -50,7 +50,7 @@ fn retiring_finds_quiet_and_broken_modes_among_padding() {
     let mut acc = vec![[0.0; COLUMNS]; 16];
     let input: Vec<f32> = (0..16).map(|n| if n == 0 { 1.0 } else { 0.0 }).collect();
     bank.process(Kernel::Scalar, Some(&input), &mut acc);
-    assert_eq!(bank.rows_active * COLUMNS - bank.num_slots, 12);
+    assert_eq!(bank.rows_active * COLUMNS - bank.num_slots, 4);
     let set = |bank: &mut ResonatorBank, m: usize, value: f32| {
         let slot = bank.slot_of_mode[m] as usize;
         (bank.re[slot], bank.im[slot]) = (value, 0.0);
@@ -86,6 +86,28 @@ fn skipped_modes_do_not_leave_lanes_empty() {
     }
     assert_eq!(bank.live, [16; COLUMNS]);
     assert_eq!(bank.num_computed(), 128);
+}
+
+#[test]
+fn kernels_compute_the_rows_the_fullest_column_needs_in_their_row_blocks() {
+    // 20 modes fill three rows.
+    let mut bank = ResonatorBank::new(20);
+    for m in 0..20 {
+        bank.activate(m, coeffs(m), 1.0);
+    }
+    let mut acc = vec![[0.0; COLUMNS]; 16];
+    for kernel in Kernel::ALL.into_iter().filter(|k| k.is_supported()) {
+        let before = bank.computed_mode_samples();
+        bank.process(kernel, None, &mut acc);
+        let rows = if kernel.row_block() == 1 { 3 } else { 4 };
+        assert_eq!(
+            bank.computed_mode_samples() - before,
+            (rows * COLUMNS * 16) as u64,
+            "{}",
+            kernel.name()
+        );
+    }
+    assert_eq!(Kernel::Avx2.row_block(), 1);
 }
 
 mod dormant {
