@@ -529,7 +529,7 @@ impl Engine {
         for v in self.voices.iter().chain(self.input_voice.as_ref()) {
             s.voices += v.is_sounding() as usize;
             s.live_modes += v.modes.num_live();
-            s.computed_modes += v.modes.num_computed();
+            s.computed_modes += v.modes.num_computed(self.kernel);
             s.dormant_modes += v.modes.num_dormant();
             s.fading_modes += v.modes.num_fading();
             s.computed_mode_samples += v.modes.computed_mode_samples();

@@ -217,14 +217,14 @@ fn retired_modes_leave_the_rest_untouched() {
         input[0] = 1.0;
         run(&mut both, kernel, &input, 64);
         run(&mut slow_only, kernel, &input, 64);
-        let computed_before = both.num_computed();
+        let computed_before = both.num_computed(kernel);
         both.retire_below(1e-6);
         assert_eq!(both.num_live(), slow_only.num_live(), "{}", kernel.name());
         assert!(
-            both.num_computed() < computed_before,
+            both.num_computed(kernel) < computed_before,
             "re-packing must shrink the work: {} modes computed before, {} after",
             computed_before,
-            both.num_computed()
+            both.num_computed(kernel)
         );
         let silence = vec![0.0f32; 4_800];
         let a = run(&mut both, kernel, &silence, 64);

@@ -180,10 +180,10 @@ impl ResonatorBank {
         self.num_slots - self.num_ghosts
     }
 
-    /// Number of slots in the rows the fullest column needs: live modes and ghosts plus padding
-    /// (a kernel that takes two rows at once may advance one row more).
-    pub fn num_computed(&self) -> usize {
-        self.rows_active * COLUMNS
+    /// Number of modes `kernel` advances per sample: live modes and ghosts, plus padding to the
+    /// rows the fullest column needs in whole row blocks of the kernel.
+    pub fn num_computed(&self, kernel: Kernel) -> usize {
+        self.rows_active.next_multiple_of(kernel.row_block()) * COLUMNS
     }
 
     /// Mode-samples the kernels have computed since the bank was made (row padding included).
@@ -288,7 +288,7 @@ impl ResonatorBank {
         }
         self.clock += acc.len() as u64;
         // Storage rows come in whole `ROW_BLOCK`s, and the rows past `rows_active` hold silence.
-        let n = self.rows_active.next_multiple_of(kernel.row_block()) * COLUMNS;
+        let n = self.num_computed(kernel);
         self.computed += (n * acc.len()) as u64;
         kernels::process(
             kernel,
@@ -314,9 +314,11 @@ impl ResonatorBank {
         // slots than those are, no live one is. (Fading modes and ghosts found here are passed
         // over below.)
         let n = self.rows_active * COLUMNS;
+        // Two-row kernels may compute one row past the fullest column's.
         debug_assert!(
-            (0..n).all(|slot| slot / COLUMNS < self.live[slot % COLUMNS] as usize
-                || (self.re[slot], self.im[slot]) == (0.0, 0.0)),
+            (0..self.rows_active.next_multiple_of(ROW_BLOCK) * COLUMNS)
+                .all(|slot| slot / COLUMNS < self.live[slot % COLUMNS] as usize
+                    || (self.re[slot], self.im[slot]) == (0.0, 0.0)),
             "an empty slot holds a state"
         );
         if count_not_above(&self.re[..n], &self.im[..n], threshold_sq) <= n - self.num_slots {

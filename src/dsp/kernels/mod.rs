@@ -11,9 +11,10 @@
 //!   latency is hidden, state in registers for the whole run;
 //! - [`Kernel::Avx512`]: AVX-512, four 16-lane vectors (64 modes) in flight.
 //!
-//! Each takes `rows` as a multiple of its [`Kernel::row_block`] (one row, or two for the kernels
-//! that advance two rows as one vector); rows after the last whole group go as a smaller group,
-//! so a bank with few modes sounding computes little padding.
+//! Each takes `rows` as a multiple of its [`Kernel::row_block`] (two rows for the portable kernel,
+//! which advances rows in pairs, and for AVX-512, whose vectors span two rows; else one); rows
+//! after the last whole group go as a smaller group, so a bank with few modes sounding computes
+//! little padding.
 
 mod portable;
 mod scalar;
@@ -25,6 +26,14 @@ pub const COLUMNS: usize = 8;
 
 /// Every kernel's [`Kernel::row_block`] divides this: storage comes in whole blocks of rows.
 pub const ROW_BLOCK: usize = 2;
+
+const _: () = {
+    let mut i = 0;
+    while i < Kernel::ALL.len() {
+        assert!(ROW_BLOCK.is_multiple_of(Kernel::ALL[i].row_block()));
+        i += 1;
+    }
+};
 
 /// An implementation of the resonator recursion.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -19,6 +19,8 @@ struct Ptrs {
     q_re: *const f32,
     q_im: *const f32,
     gain: *const f32,
+    /// Length of every slice.
+    len: usize,
 }
 
 impl Ptrs {
@@ -29,6 +31,7 @@ impl Ptrs {
             q_re: rows.q_re.as_ptr(),
             q_im: rows.q_im.as_ptr(),
             gain: rows.gain.as_ptr(),
+            len: rows.re.len(),
         }
     }
 }
@@ -91,6 +94,7 @@ unsafe fn avx2_group<const V: usize>(
     acc: &mut [[f32; COLUMNS]],
 ) {
     const W: usize = 8;
+    debug_assert!(start + V * W <= p.len, "a group runs past the rows");
     let accp = acc.as_mut_ptr() as *mut f32;
     // SAFETY: the caller keeps start..start + 8 V within the slices; each of the `acc.len()`
     // accumulator rows holds 8 lanes; `process` checked the input has `acc.len()` samples.
@@ -199,6 +203,7 @@ unsafe fn avx512_group<const V: usize>(
     acc: &mut [[f32; COLUMNS]],
 ) {
     const W: usize = 16;
+    debug_assert!(start + V * W <= p.len, "a group runs past the rows");
     let accp = acc.as_mut_ptr() as *mut f32;
     // SAFETY: the caller keeps start..start + 16 V within the slices; each of the `acc.len()`
     // accumulator rows holds 8 lanes; `process` checked the input has `acc.len()` samples.
