@@ -6,6 +6,15 @@ fn coeffs(mode: usize) -> ModeCoeffs {
     ModeCoeffs::from_freq_decay(48_000.0, 100.0 + 37.0 * mode as f64, 3.0 + mode as f64)
 }
 
+/// A bank of `n` modes, all sounding with gain 1.
+fn sounding(n: usize) -> ResonatorBank {
+    let mut bank = ResonatorBank::new(n);
+    for m in 0..n {
+        bank.activate(m, coeffs(m), 1.0);
+    }
+    bank
+}
+
 #[test]
 fn repacking_keeps_each_mode_with_its_state() {
     let mut bank = ResonatorBank::new(100);
@@ -43,10 +52,7 @@ fn repacking_keeps_each_mode_with_its_state() {
 fn retiring_finds_quiet_and_broken_modes_among_padding() {
     // 20 modes: columns 0-3 hold three, columns 4-7 two, so the rows the kernels run over hold
     // 4 empty slots (12 for a kernel taking two rows at once).
-    let mut bank = ResonatorBank::new(20);
-    for m in 0..20 {
-        bank.activate(m, coeffs(m), 1.0);
-    }
+    let mut bank = sounding(20);
     let mut acc = vec![[0.0; COLUMNS]; 16];
     let input: Vec<f32> = (0..16).map(|n| if n == 0 { 1.0 } else { 0.0 }).collect();
     bank.process(Kernel::Scalar, Some(&input), &mut acc);
@@ -91,10 +97,7 @@ fn skipped_modes_do_not_leave_lanes_empty() {
 #[test]
 fn kernels_compute_the_rows_the_fullest_column_needs_in_their_row_blocks() {
     // 20 modes fill three rows.
-    let mut bank = ResonatorBank::new(20);
-    for m in 0..20 {
-        bank.activate(m, coeffs(m), 1.0);
-    }
+    let mut bank = sounding(20);
     let mut acc = vec![[0.0; COLUMNS]; 16];
     for kernel in Kernel::ALL.into_iter().filter(|k| k.is_supported()) {
         let before = bank.computed_mode_samples();
