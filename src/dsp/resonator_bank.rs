@@ -117,6 +117,8 @@ pub struct ResonatorBank {
     pulses: [(u64, Pulse); strike::MAX_PULSES],
     /// Scratch for a strike taken by every dormant record at once.
     absorb: absorb::AbsorbScratch,
+    /// Each mode's response to the last pulse it took analytically.
+    responses: Vec<strike::CachedResponse>,
     /// Number of `pulses` in use.
     num_pulses: usize,
 }
@@ -161,6 +163,7 @@ impl ResonatorBank {
             computed: 0,
             pulses: [(0, Pulse::NONE); strike::MAX_PULSES],
             absorb: absorb::AbsorbScratch::new(num_modes),
+            responses: vec![strike::CachedResponse::EMPTY; num_modes],
             num_pulses: 0,
         }
     }

@@ -12,7 +12,7 @@
 
 use std::f64::consts::{PI, TAU};
 
-use super::{ModeCoeffs, PulseShape, ResonatorBank, COLUMNS, NONE};
+use super::{ModeCoeffs, ResonatorBank, COLUMNS, NONE};
 use crate::dsp::coeffs_batch::{cos_series, sin_series};
 use crate::dsp::masking::{power_to_db, DB_PER_NEPER};
 
@@ -54,10 +54,6 @@ pub(super) struct Dormant {
     pub p_im: f64,
     /// The pruner's note about what keeps the mode off (its masker).
     pub tag: u32,
-    /// This pole's response to a unit pulse of `response_len` samples of `response_shape`,
-    /// referred to the sample before the pulse (`None` until a strike asks for it): strikes on
-    /// an object usually repeat their mallet.
-    pub response: Option<(PulseShape, u32, f64, f64)>,
     /// Bank clock at which it started from rest without being computed
     /// ([`ResonatorBank::start_dormant`]), else `u64::MAX`: woken at that instant it has no
     /// ringing of its own to fade back in.
@@ -88,7 +84,6 @@ impl Dormant {
         p_re: 1.0,
         p_im: 0.0,
         tag: 0,
-        response: None,
         rest_at: u64::MAX,
         pulse_left: 0,
         pulse_peak_db: f32::INFINITY,
@@ -100,7 +95,6 @@ impl Dormant {
             (self.theta, self.delta) = (theta, delta);
             let c = ModeCoeffs::from_angle_radius(theta, delta);
             (self.p_re, self.p_im) = (1.0 + c.q_re as f64, c.q_im as f64);
-            self.response = None;
         }
     }
 
@@ -257,7 +251,6 @@ impl ResonatorBank {
                 p_re: 1.0 + self.q_re[slot] as f64,
                 p_im: self.q_im[slot] as f64,
                 tag,
-                response: None,
                 rest_at: u64::MAX,
                 pulse_left: 0,
                 pulse_peak_db: f32::INFINITY,

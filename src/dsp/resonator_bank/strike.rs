@@ -226,14 +226,7 @@ impl ResonatorBank {
             d.advance_to(now);
             let gain = gain_of(d.mode as usize);
             let p = C::new(d.p_re, d.p_im);
-            let response = match d.response {
-                Some((shape, len, re, im)) if (shape, len) == key => C::new(re, im),
-                _ => {
-                    let r = prepared.response(p, 0, u32::MAX);
-                    d.response = Some((key.0, key.1, r.re, r.im));
-                    r
-                }
-            };
+            let response = self.responses[d.mode as usize].get(p, key, &prepared);
             let mut added = response.scale(pulse.amplitude as f64 * gain as f64);
             let change = gain as f64 - d.gain as f64;
             let bounded = d.pulse_left > 0 || d.delta * span as f64 > BOUND_NEPERS;
@@ -327,6 +320,49 @@ impl ResonatorBank {
         } else {
             (0.0, 0.0)
         }
+    }
+}
+
+/// A pole's response to a unit pulse, referred to the sample before the pulse: kept for each
+/// mode, whichever record holds it, since strikes on an object usually repeat their mallet and a
+/// mode restarted from rest at the same pitch has the same pole.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct CachedResponse {
+    /// The pole it was worked out for, real part.
+    p_re: f64,
+    /// The pole, imaginary part.
+    p_im: f64,
+    /// The pulse's shape.
+    shape: PulseShape,
+    /// The pulse's length in samples; 0 in an empty entry, which no pulse matches.
+    len: u32,
+    /// The response.
+    response: C,
+}
+
+impl CachedResponse {
+    /// Nothing cached.
+    pub const EMPTY: Self = Self {
+        p_re: 0.0,
+        p_im: 0.0,
+        shape: PulseShape::Impulse,
+        len: 0,
+        response: C::ZERO,
+    };
+
+    /// The response of pole `p` to the unit pulse `prepared` of `key` (shape and length), from
+    /// the cache or worked out and kept.
+    fn get(&mut self, p: C, key: (PulseShape, u32), prepared: &Prepared) -> C {
+        if (self.p_re, self.p_im, self.shape, self.len) != (p.re, p.im, key.0, key.1) {
+            *self = Self {
+                p_re: p.re,
+                p_im: p.im,
+                shape: key.0,
+                len: key.1,
+                response: prepared.response(p, 0, u32::MAX),
+            };
+        }
+        self.response
     }
 }
 

@@ -323,11 +323,9 @@ mod strike {
         0.8 - 0.03 * m as f32
     }
 
-    /// Strikes both banks with `kind` over `len` samples, the pruned one with its odd modes
-    /// dormant (taking the strike analytically), wakes everything `wake_after` samples into the
-    /// pulse, and compares the states once the ghosts have joined.
-    fn check(kind: ExciterKind, len: u32, wake_after: usize) {
-        let n = 24;
+    /// A [`ringing`] bank of `n` modes with its odd modes switched off and faded out, and the same
+    /// bank with every mode computed.
+    fn half_dormant(n: usize) -> (ResonatorBank, ResonatorBank) {
         let mut pruned = ringing(n);
         let mut reference = pruned.clone();
         for m in (1..n).step_by(2) {
@@ -339,6 +337,15 @@ mod strike {
             bank.finish_fades();
         }
         assert_eq!(pruned.num_dormant(), n / 2);
+        (pruned, reference)
+    }
+
+    /// Strikes both banks with `kind` over `len` samples, the pruned one with its odd modes
+    /// dormant (taking the strike analytically), wakes everything `wake_after` samples into the
+    /// pulse, and compares the states once the ghosts have joined.
+    fn check(kind: ExciterKind, len: u32, wake_after: usize) {
+        let n = 24;
+        let (mut pruned, mut reference) = half_dormant(n);
         let mut exciter = Exciter::new(3);
         exciter.strike(kind, 0.7, len);
         let mut x = vec![0.0; 2048];
@@ -373,13 +380,25 @@ mod strike {
                 bank.finish_fades();
             }
         }
-        assert_eq!(pruned.num_fading(), 0);
+        let what = format!("{kind:?} over {len}, woken after {wake_after}");
+        assert_woken_as_computed(&pruned, &reference, n, &what);
+    }
+
+    /// Every one of the `n` modes of `pruned`, woken and with its ghost joined, is where
+    /// `reference` (computed throughout) leaves it.
+    fn assert_woken_as_computed(
+        pruned: &ResonatorBank,
+        reference: &ResonatorBank,
+        n: usize,
+        what: &str,
+    ) {
+        assert_eq!(pruned.num_fading(), 0, "{what}: still fading");
         for m in 0..n {
             let (a, b) = (pruned.state(m).unwrap(), reference.state(m).unwrap());
             let scale = b.0.hypot(b.1).max(1e-3);
             assert!(
                 (a.0 - b.0).abs() < 2e-4 * scale && (a.1 - b.1).abs() < 2e-4 * scale,
-                "{kind:?} over {len}, woken after {wake_after}: mode {m}: {a:?} vs {b:?}"
+                "{what}: mode {m}: {a:?} vs {b:?}"
             );
         }
     }
@@ -401,6 +420,46 @@ mod strike {
         for (len, after) in [(15, 7), (600, 64), (600, 599)] {
             check(ExciterKind::Mallet, len, after);
         }
+    }
+
+    /// A dormant mode takes a pulse with its own pole's response, whatever it took before: struck,
+    /// retuned and struck with the same mallet again (the response kept from the first strike no
+    /// longer holds), then struck once more at the new pitch (it does), its state is where
+    /// computing it all along leaves it.
+    #[test]
+    fn a_retuned_dormant_mode_takes_the_next_strike_with_its_new_pole() {
+        let (n, len) = (24, 15);
+        let (mut pruned, mut reference) = half_dormant(n);
+        for bank in [&mut pruned, &mut reference] {
+            bank.set_gains_with(gain);
+        }
+        let mut exciter = Exciter::new(3);
+        for pitch in [1.0, 1.5, 1.5] {
+            for bank in [&mut pruned, &mut reference] {
+                bank.set_poles_with(|m| {
+                    let f = pitch * (40.0 + 397.0 * m as f64);
+                    (TAU * f / RATE, (1.0 + 40.0 * (m % 3) as f64) / RATE)
+                });
+            }
+            pruned.absorb_strike(mallet(0.7, len), true, gain);
+            exciter.strike(ExciterKind::Mallet, 0.7, len);
+            let mut x = vec![0.0; 320];
+            exciter.render(&mut x);
+            for bank in [&mut pruned, &mut reference] {
+                let mut acc = vec![[0.0; COLUMNS]; x.len()];
+                bank.process(Kernel::Scalar, Some(&x), &mut acc);
+            }
+        }
+        assert_eq!(pruned.num_dormant(), n / 2);
+        pruned.wake_all();
+        for bank in [&mut pruned, &mut reference] {
+            for _ in 0..32 {
+                let mut acc = vec![[0.0; COLUMNS]; 64];
+                bank.process(Kernel::Scalar, None, &mut acc);
+                bank.finish_fades();
+            }
+        }
+        assert_woken_as_computed(&pruned, &reference, n, "after the retune");
     }
 
     /// A pulse of `len` samples of amplitude `amplitude`, as the exciter's mallet.
