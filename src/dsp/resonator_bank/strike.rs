@@ -328,14 +328,11 @@ impl ResonatorBank {
 /// mode restarted from rest at the same pitch has the same pole.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct CachedResponse {
-    /// The pole it was worked out for, real part.
-    p_re: f64,
-    /// The pole, imaginary part.
-    p_im: f64,
-    /// The pulse's shape.
-    shape: PulseShape,
-    /// The pulse's length in samples; 0 in an empty entry, which no pulse matches.
-    len: u32,
+    /// The pole it was worked out for.
+    pole: C,
+    /// The pulse's shape and length in samples; a length of 0 in an empty entry, which no pulse
+    /// matches.
+    key: (PulseShape, u32),
     /// The response.
     response: C,
 }
@@ -343,22 +340,18 @@ pub(super) struct CachedResponse {
 impl CachedResponse {
     /// Nothing cached.
     pub const EMPTY: Self = Self {
-        p_re: 0.0,
-        p_im: 0.0,
-        shape: PulseShape::Impulse,
-        len: 0,
+        pole: C::ZERO,
+        key: (PulseShape::Impulse, 0),
         response: C::ZERO,
     };
 
     /// The response of pole `p` to the unit pulse `prepared` of `key` (shape and length), from
     /// the cache or worked out and kept.
     fn get(&mut self, p: C, key: (PulseShape, u32), prepared: &Prepared) -> C {
-        if (self.p_re, self.p_im, self.shape, self.len) != (p.re, p.im, key.0, key.1) {
+        if (self.pole, self.key) != (p, key) {
             *self = Self {
-                p_re: p.re,
-                p_im: p.im,
-                shape: key.0,
-                len: key.1,
+                pole: p,
+                key,
                 response: prepared.response(p, 0, u32::MAX),
             };
         }
