@@ -11,6 +11,7 @@ pub mod exciter;
 pub mod kernels;
 pub mod masking;
 pub mod onset;
+pub mod prefetch;
 pub mod pruning;
 pub mod resonator_bank;
 pub mod rng;

@@ -19,6 +19,7 @@
 use super::dormant::Dormant;
 use super::{ResonatorBank, NONE};
 use crate::dsp::masking::power_to_db;
+use crate::dsp::prefetch::{self, prefetch};
 
 /// Most pulses kept track of at once (as many as one exciter overlaps).
 pub(super) const MAX_PULSES: usize = 4;
@@ -214,6 +215,10 @@ impl ResonatorBank {
         let scratch = &mut self.absorb;
         let (mut n, mut num_waking) = (0, 0);
         for r in 0..self.num_dormant {
+            // The records are in no order of mode: ask early for a later one's response.
+            if let Some(ahead) = self.dormant[..self.num_dormant].get(r + prefetch::AHEAD) {
+                prefetch(&self.responses, ahead.mode as usize);
+            }
             let d = &mut self.dormant[r];
             if self.slot_of_mode[d.mode as usize] != NONE {
                 continue;

@@ -27,6 +27,7 @@ use super::candidates::{energy_db, Reading, DORMANT, DRIVEN};
 use super::{samples_to_cross, OffReason, NO_TAG};
 use crate::dsp::coeffs::db_to_gain;
 use crate::dsp::masking::{power_to_db, DB_PER_NEPER};
+use crate::dsp::prefetch::{self, prefetch};
 use crate::dsp::resonator_bank::{Pulse, PulseShape};
 use crate::dsp::ExciterKind;
 use crate::engine::voice::start_threshold;
@@ -225,7 +226,12 @@ impl Engine {
             p.lift_db.fill((0, 0.0, 0.0));
             p.lift_stamp = 1;
         }
-        for d in &p.dormant_scratch[..num_dormant] {
+        let dormant = &p.dormant_scratch[..num_dormant];
+        for (k, d) in dormant.iter().enumerate() {
+            // The records are in no order of mode: ask early for a later one's reason.
+            if let Some(ahead) = dormant.get(k + prefetch::AHEAD) {
+                prefetch(&p.off, i * stride + ahead.mode);
+            }
             // A mode off for the budget is judged like a lifted one (its reason names no
             // voice generation).
             let reason = p.off[i * stride + d.mode];
