@@ -220,7 +220,8 @@ impl ResonatorBank {
                 prefetch(&self.responses, ahead.mode as usize);
             }
             let d = &mut self.dormant[r];
-            if self.slot_of_mode[d.mode as usize] != NONE {
+            // Only a mode fading out has a slot beside its record.
+            if self.num_fading_out > 0 && self.slot_of_mode[d.mode as usize] != NONE {
                 continue;
             }
             if d.delta > too_damped {

@@ -555,6 +555,28 @@ mod strike {
     }
 
     #[test]
+    fn a_mode_still_fading_out_is_left_to_its_fade_by_strikes_and_scans() {
+        let mut bank = sounding(4);
+        let mut x = vec![0.0; 64];
+        x[0] = 0.1;
+        bank.process(Kernel::Scalar, Some(&x), &mut vec![[0.0; COLUMNS]; 64]);
+        // Mode 0's fade is over after 128 samples; mode 1's is not.
+        bank.switch_off(0, 64, 0, 0);
+        bank.switch_off(1, 1024, 0, 0);
+        bank.process(Kernel::Scalar, None, &mut vec![[0.0; COLUMNS]; 128]);
+        bank.finish_fades();
+        let mut listed = Vec::new();
+        bank.for_each_dormant(u64::MAX, |d| listed.push(d.mode));
+        assert_eq!(listed, [0], "only mode 0 is dormant");
+        let pulse = Pulse {
+            shape: PulseShape::Impulse,
+            amplitude: 0.1,
+            len: 1,
+        };
+        assert_eq!(bank.absorb_strike(pulse, true, |_| 1.0), 1, "absorbed");
+    }
+
+    #[test]
     fn overlapping_strikes_with_new_gains_leave_dormant_modes_where_computing_would() {
         // Woken during both pulses, during the first's end, and after both.
         for (t2, wake_at) in [(200, 300), (200, 580), (100, 1200)] {

@@ -128,7 +128,8 @@ impl ResonatorBank {
             if recheck_at > due {
                 continue;
             }
-            if self.slot_of_mode[d.mode as usize] != NONE {
+            // Only a mode fading out has a slot beside its record.
+            if self.num_fading_out > 0 && self.slot_of_mode[d.mode as usize] != NONE {
                 continue;
             }
             f(DormantMode {
