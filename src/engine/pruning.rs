@@ -298,11 +298,11 @@ impl Pruner {
         let mut num = 0;
         for j in 0..m.len {
             let vi = (m.who[j] >> 24) as usize;
-            let k = vi * self.cands.stride + (m.who[j] & candidates::MODE_MASK) as usize;
+            let mode = (m.who[j] & candidates::MODE_MASK) as usize;
             if skip_voice == Some(vi)
                 || self.struck[vi]
                 || self.generation[vi] != m.generation[j]
-                || self.cands.index_of[k] != 0
+                || self.cands.has(vi, mode)
             {
                 continue;
             }

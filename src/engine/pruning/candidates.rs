@@ -85,12 +85,31 @@ pub(super) struct Candidates {
     pub len: usize,
     /// Modes per voice: the stride of the per-mode tables.
     pub stride: usize,
-    /// Bark and threshold in quiet of each voice's modes at its tuning (voice-major).
-    psycho: Vec<(f32, f32)>,
-    /// The voice generation each `psycho` entry was computed for.
-    psycho_generation: Vec<u32>,
-    /// One more than each mode's candidate index, or 0 (voice-major).
-    pub index_of: Vec<u32>,
+    /// What is kept of each voice's modes (voice-major), in one place since the modes come in
+    /// no order and each is a cache miss.
+    per_mode: Vec<PerMode>,
+}
+
+/// What the candidates keep of one mode of one voice.
+#[derive(Debug, Clone, Copy)]
+struct PerMode {
+    /// Critical-band rate at the voice's tuning.
+    bark: f32,
+    /// Threshold in quiet there, dB SPL.
+    threshold_db: f32,
+    /// The voice generation `bark` and `threshold_db` were worked out for.
+    generation: u32,
+    /// One more than the mode's candidate index, or 0.
+    index: u32,
+}
+
+impl PerMode {
+    const UNKNOWN: Self = Self {
+        bark: 0.0,
+        threshold_db: 0.0,
+        generation: u32::MAX,
+        index: 0,
+    };
 }
 
 impl Candidates {
@@ -112,9 +131,7 @@ impl Candidates {
             verdicts: vec![Verdict::Inaudible; n],
             len: 0,
             stride: num_modes,
-            psycho: vec![(0.0, 0.0); n],
-            psycho_generation: vec![u32::MAX; n],
-            index_of: vec![0; n],
+            per_mode: vec![PerMode::UNKNOWN; n],
         }
     }
 
@@ -134,13 +151,14 @@ impl Candidates {
         reading: &Reading,
     ) {
         // Bark and threshold in quiet follow the voice's tuning: kept until it changes.
-        let k = voice * self.stride + mode;
-        if self.psycho_generation[k] != generation {
-            self.psycho[k] = self.table.lookup((theta * reading.radians_to_hz) as f32);
-            self.psycho_generation[k] = generation;
-        }
-        let (bark, threshold_db) = self.psycho[k];
         let i = self.len;
+        let pm = &mut self.per_mode[voice * self.stride + mode];
+        if pm.generation != generation {
+            (pm.bark, pm.threshold_db) = self.table.lookup((theta * reading.radians_to_hz) as f32);
+            pm.generation = generation;
+        }
+        pm.index = i as u32 + 1;
+        let (bark, threshold_db) = (pm.bark, pm.threshold_db);
         self.level_db[i] = raw_db + reading.calibration_db;
         self.raw_db[i] = raw_db;
         self.bark[i] = bark;
@@ -152,8 +170,12 @@ impl Candidates {
         }
         self.who[i] = ((voice as u32) << 24) | mode as u32;
         self.flags[i] = flags;
-        self.index_of[k] = i as u32 + 1;
         self.len += 1;
+    }
+
+    /// Whether mode `mode` of voice `voice` is a candidate.
+    pub fn has(&self, voice: usize, mode: usize) -> bool {
+        self.per_mode[voice * self.stride + mode].index != 0
     }
 
     /// Voice and mode of candidate `i`.
@@ -168,7 +190,7 @@ impl Candidates {
     pub fn clear(&mut self) {
         for i in 0..self.len {
             let (voice, mode) = self.voice_mode(i);
-            self.index_of[voice * self.stride + mode] = 0;
+            self.per_mode[voice * self.stride + mode].index = 0;
         }
         self.len = 0;
     }
