@@ -330,6 +330,28 @@ fn strike_position_selects_the_gain_column() {
 }
 
 #[test]
+fn a_strike_starts_exactly_the_modes_its_point_reaches() {
+    // 21 modes (not a whole number of eights), struck at a point that reaches three: one in
+    // each eight, the last in the short one at the end.
+    let reached = [2usize, 9, 20];
+    let modes: Vec<_> = (0..21)
+        .map(|m| {
+            (
+                200.0 + 50.0 * m as f64,
+                2.0,
+                reached.contains(&m) as u8 as f64,
+            )
+        })
+        .collect();
+    let mut e = engine(&simple_bank(&modes), RATE);
+    render(&mut e, &[on(0, 60, 1.0)], 0.01, 64);
+    let mut sounding = Vec::new();
+    e.visit_mode_energies(|m, _| sounding.push(m));
+    sounding.sort_unstable();
+    assert_eq!(sounding, reached);
+}
+
+#[test]
 fn a_restrike_that_starts_new_modes_plays_them_at_the_voice_pitch() {
     // Struck at a, then at b on the same ringing key (the voice's tuning unchanged): the
     // second strike starts the 1.7 kHz mode alone, and the output is the sum of the two

@@ -216,30 +216,52 @@ impl Voice {
         let pitch = tuning.log_pitch.exp();
         let bound = amplitude * kind.peak_bound(len_samples);
         let threshold = start_threshold(threshold, bank.num_modes());
-        for (m, &gain) in gains[..bank.num_modes()].iter().enumerate() {
-            let heard = gain.abs() * bound >= threshold;
-            if !heard || self.modes.is_live(m) {
+        let heard = |gain: f32| gain.abs() * bound >= threshold;
+        // A strike point reaches some of a bank's modes only (one object of a scene): runs of
+        // modes it cannot lift are passed over eight at a time, without a branch for each.
+        for (c, chunk) in gains[..bank.num_modes()].chunks(8).enumerate() {
+            if !chunk.iter().fold(false, |any, &g| any | heard(g)) {
                 continue;
             }
-            let theta = TAU * bank.freq_hz[m] * pitch / sample_rate_hz;
-            if theta < THETA_MAX && start_dormant {
-                let fade = fade_samples(theta as f32, sample_rate_hz);
-                self.modes.start_dormant(m, fade);
-            } else if theta < THETA_MAX {
-                // Coefficients follow below, for all modes at once.
-                self.modes.activate(
-                    m,
-                    ModeCoeffs {
-                        q_re: 0.0,
-                        q_im: 0.0,
-                    },
-                    gain,
-                );
+            for (k, &gain) in chunk.iter().enumerate() {
+                let m = 8 * c + k;
+                if heard(gain) && !self.modes.is_live(m) {
+                    self.start_mode(bank, sample_rate_hz, pitch, m, gain, start_dormant);
+                }
             }
         }
         self.modes.set_gains_with(|m| gains[m]);
         self.retune(bank, decay, sample_rate_hz, tuning);
         self.exciter.strike(kind, amplitude, len_samples);
+    }
+
+    /// Starts mode `m`, struck with `gain`, at `pitch`: dormant with `start_dormant`, else
+    /// computed (its coefficients follow with the retune after the strike); not at all if the
+    /// pitch takes it out of range.
+    fn start_mode(
+        &mut self,
+        bank: &PreparedBank,
+        sample_rate_hz: f64,
+        pitch: f64,
+        m: usize,
+        gain: f32,
+        start_dormant: bool,
+    ) {
+        let theta = TAU * bank.freq_hz[m] * pitch / sample_rate_hz;
+        if theta < THETA_MAX && start_dormant {
+            let fade = fade_samples(theta as f32, sample_rate_hz);
+            self.modes.start_dormant(m, fade);
+        } else if theta < THETA_MAX {
+            // Coefficients follow with the retune, for all modes at once.
+            self.modes.activate(
+                m,
+                ModeCoeffs {
+                    q_re: 0.0,
+                    q_im: 0.0,
+                },
+                gain,
+            );
+        }
     }
 }
 
