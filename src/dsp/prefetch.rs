@@ -2,12 +2,12 @@
 //! order of some other list (dormant records), where the hardware cannot guess the next
 //! address.
 
-/// How many steps ahead to ask: enough to cover a miss to memory behind a loop's step of a few
-/// dozen cycles.
+/// How many steps ahead to ask: enough for a miss to be served while the loop does the steps in
+/// between.
 pub const AHEAD: usize = 8;
 
 /// Hints that `items[i]` will be read soon. Does nothing if `i` is out of range, or on targets
-/// without a prefetch instruction; never reads or faults.
+/// other than x86-64; never reads or faults.
 #[inline(always)]
 pub fn prefetch<T>(items: &[T], i: usize) {
     #[cfg(target_arch = "x86_64")]

@@ -221,6 +221,7 @@ impl ResonatorBank {
             }
             let d = &mut self.dormant[r];
             // Only a mode fading out has a slot beside its record.
+            debug_assert!(self.num_fading_out > 0 || self.slot_of_mode[d.mode as usize] == NONE);
             if self.num_fading_out > 0 && self.slot_of_mode[d.mode as usize] != NONE {
                 continue;
             }

@@ -568,6 +568,7 @@ mod strike {
         let mut listed = Vec::new();
         bank.for_each_dormant(u64::MAX, |d| listed.push(d.mode));
         assert_eq!(listed, [0], "only mode 0 is dormant");
+        // The engine wakes fading modes before a strike; if one is not, it is still left alone.
         let pulse = Pulse {
             shape: PulseShape::Impulse,
             amplitude: 0.1,
