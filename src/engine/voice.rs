@@ -218,13 +218,14 @@ impl Voice {
         let threshold = start_threshold(threshold, bank.num_modes());
         let heard = |gain: f32| gain.abs() * bound >= threshold;
         // A strike point reaches some of a bank's modes only (one object of a scene): runs of
-        // modes it cannot lift are passed over eight at a time, without a branch for each.
-        for (c, chunk) in gains[..bank.num_modes()].chunks(8).enumerate() {
+        // modes it cannot lift are passed over `RUN` at a time, without a branch for each.
+        const RUN: usize = 8;
+        for (c, chunk) in gains[..bank.num_modes()].chunks(RUN).enumerate() {
             if !chunk.iter().fold(false, |any, &g| any | heard(g)) {
                 continue;
             }
             for (k, &gain) in chunk.iter().enumerate() {
-                let m = 8 * c + k;
+                let m = RUN * c + k;
                 if heard(gain) && !self.modes.is_live(m) {
                     self.start_mode(bank, sample_rate_hz, pitch, m, gain, start_dormant);
                 }

@@ -172,7 +172,15 @@ impl ResonatorBank {
         self.dormant[..self.num_dormant]
             .iter()
             .map(|d| d.mode as usize)
-            .filter(|&m| self.slot_of_mode[m] == NONE)
+            .filter(|&m| !self.still_fading_out(m))
+    }
+
+    /// Whether `mode`, which has a record, is still fading out: the one case of a mode with a
+    /// slot beside its record, so the slot is looked up only while some mode fades out.
+    #[inline]
+    pub(super) fn still_fading_out(&self, mode: usize) -> bool {
+        debug_assert!(self.num_fading_out > 0 || self.slot_of_mode[mode] == NONE);
+        self.num_fading_out > 0 && self.slot_of_mode[mode] != NONE
     }
 
     /// Number of slots fading in or out, ghosts included.

@@ -17,7 +17,7 @@
 //! computed through it (they soon die away).
 
 use super::dormant::Dormant;
-use super::{ResonatorBank, NONE};
+use super::ResonatorBank;
 use crate::dsp::masking::power_to_db;
 use crate::dsp::prefetch::{self, prefetch};
 
@@ -212,19 +212,16 @@ impl ResonatorBank {
         // of the new states then runs over all of them at once.
         // Modes too damped to refer the pulses back to now are computed through them instead.
         let too_damped = MAX_ABSORB_NEPERS / span as f64;
-        let scratch = &mut self.absorb;
         let (mut n, mut num_waking) = (0, 0);
         for r in 0..self.num_dormant {
             // The records are in no order of mode: ask early for a later one's response.
             if let Some(ahead) = self.dormant[..self.num_dormant].get(r + prefetch::AHEAD) {
                 prefetch(&self.responses, ahead.mode as usize);
             }
-            let d = &mut self.dormant[r];
-            // Only a mode fading out has a slot beside its record.
-            debug_assert!(self.num_fading_out > 0 || self.slot_of_mode[d.mode as usize] == NONE);
-            if self.num_fading_out > 0 && self.slot_of_mode[d.mode as usize] != NONE {
+            if self.still_fading_out(self.dormant[r].mode as usize) {
                 continue;
             }
+            let (d, scratch) = (&mut self.dormant[r], &mut self.absorb);
             if d.delta > too_damped {
                 scratch.waking[num_waking] = r as u32;
                 num_waking += 1;
@@ -272,6 +269,7 @@ impl ResonatorBank {
                 self.recheck[r] = now;
             }
         }
+        let scratch = &mut self.absorb;
         scratch.run(n);
         for k in 0..n {
             let d = &mut self.dormant[scratch.record[k] as usize];

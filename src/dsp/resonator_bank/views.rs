@@ -128,9 +128,7 @@ impl ResonatorBank {
             if recheck_at > due {
                 continue;
             }
-            // Only a mode fading out has a slot beside its record.
-            debug_assert!(self.num_fading_out > 0 || self.slot_of_mode[d.mode as usize] == NONE);
-            if self.num_fading_out > 0 && self.slot_of_mode[d.mode as usize] != NONE {
+            if self.still_fading_out(d.mode as usize) {
                 continue;
             }
             f(DormantMode {
