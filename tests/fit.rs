@@ -518,112 +518,75 @@ fn the_mode_count_and_frequency_range_are_respected() {
     }
 }
 
-#[test]
-fn modes_closer_than_the_difference_limen_come_out_as_one() {
-    // 1 Hz apart at 1 kHz, where the limen is 2.5 Hz (seed 000 section 5.4.1): one mode.
+/// The bank of `modes` (frequency, decay, gains at the two ends), fitted from its noisy renders
+/// at both ends.
+fn fit_of(modes: &[(f64, f64, [f64; 2])], seed: u64) -> Bank {
     let mut bank = Bank::new("pair", common::two_ends());
-    for (freq_hz, decay_per_s, gains) in [
-        (440.0, 2.0, vec![0.3, 0.2]),
-        (1000.0, 3.0, vec![0.1, 0.05]),
-        (1001.0, 3.0, vec![0.1, 0.05]),
-    ] {
+    for &(freq_hz, decay_per_s, gains) in modes {
         bank.modes.push(Mode {
             freq_hz,
             decay_per_s,
-            gains,
+            gains: gains.to_vec(),
         });
     }
     let recordings: Vec<Recording> = (0..2)
-        .map(|k| noisy_recording(&bank, k, SNR_DB, 50 + k as u64))
+        .map(|k| noisy_recording(&bank, k, SNR_DB, seed + k as u64))
         .collect();
-    let fit = fit_bank(&recordings, &FitOptions::default()).unwrap();
-    let near: Vec<f64> = fit
-        .bank
-        .modes
+    fit_bank(&recordings, &FitOptions::default()).unwrap().bank
+}
+
+/// The modes of `bank` within `within_hz` of `freq_hz`.
+fn modes_near(bank: &Bank, freq_hz: f64, within_hz: f64) -> Vec<&Mode> {
+    bank.modes
         .iter()
-        .map(|m| m.freq_hz)
-        .filter(|f| (f - 1000.5).abs() < 10.0)
-        .collect();
-    assert_eq!(near.len(), 1, "modes near 1 kHz: {near:?}");
-    assert!(
-        (near[0] - 1000.5).abs() < 1.0,
-        "merged mode at {} Hz",
-        near[0]
-    );
-    assert_eq!(fit.bank.modes.len(), 2, "{:?}", fit.bank.modes);
-    // The pair beats once a second, which no exponential follows: the report says so.
-    let fit_error = |freq_hz: f64| {
-        let m = fit
-            .report
-            .modes
-            .iter()
-            .find(|m| (m.freq_hz - freq_hz).abs() < 10.0)
-            .unwrap();
-        println!(
-            "{} Hz: {:.2} dB from the exponential",
-            m.freq_hz, m.fit_error_db
-        );
-        m.fit_error_db
-    };
-    let (single, beating) = (fit_error(440.0), fit_error(1000.5));
-    assert!(single < FIT_ERROR_DB, "the single mode: {single} dB");
-    assert!(
-        beating > 2.0 * FIT_ERROR_DB,
-        "the beating pair: {beating} dB"
-    );
+        .filter(|m| (m.freq_hz - freq_hz).abs() < within_hz)
+        .collect()
 }
 
 #[test]
-fn a_resolved_pair_within_the_difference_limen_merges_into_one_mode() {
-    // 40 Hz apart at 8 kHz: seven bins of the analysis window, so the analysis sees two modes,
-    // but half the 80 Hz limen there (seed 000 section 5.4.1), so a listener hears one. The
-    // merged mode sits at the pair's frequency and decay averaged with weights of their
-    // amplitudes squared (the noise is white, so each stands as far above it).
-    let (low, high) = ((8000.0, 6.0, 0.1), (8040.0, 12.0, 0.09));
-    let mut bank = Bank::new(
-        "resolved pair",
-        ["a", "b"]
-            .iter()
-            .enumerate()
-            .map(|(k, name)| Position {
-                name: name.to_string(),
-                coords: vec![k as f64],
-            })
-            .collect(),
+fn a_beating_pair_comes_out_as_two_modes() {
+    // 1 Hz apart at 1 kHz, inside the 2.5 Hz limen (seed 000 section 5.4.1): alone, each is
+    // one pitch, but together they beat once a second, which one mode cannot do.
+    let fit = fit_of(
+        &[
+            (440.0, 2.0, [0.3, 0.2]),
+            (1000.0, 3.0, [0.1, 0.05]),
+            (1001.0, 3.0, [0.1, 0.05]),
+        ],
+        50,
     );
-    for (freq_hz, decay_per_s, gain) in [(440.0, 2.0, 0.3), low, high] {
-        bank.modes.push(Mode {
-            freq_hz,
-            decay_per_s,
-            gains: vec![gain, gain],
-        });
+    let near = modes_near(&fit, 1000.5, 10.0);
+    assert_eq!(near.len(), 2, "modes near 1 kHz: {:?}", fit.modes);
+    for (m, want) in near.iter().zip([1000.0, 1001.0]) {
+        assert!(
+            (m.freq_hz - want).abs() < 0.1 && (m.decay_per_s / 3.0 - 1.0).abs() < 0.1,
+            "{want} Hz, 3 /s: found {m:?}"
+        );
     }
-    let recordings: Vec<Recording> = (0..2)
-        .map(|k| noisy_recording(&bank, k, SNR_DB, 70 + k as u64))
-        .collect();
-    let fit = fit_bank(&recordings, &FitOptions::default()).unwrap();
-    let near: Vec<&Mode> = fit
-        .bank
-        .modes
-        .iter()
-        .filter(|m| (m.freq_hz - 8020.0).abs() < 100.0)
-        .collect();
-    assert_eq!(near.len(), 1, "modes near 8 kHz: {:?}", fit.bank.modes);
-    let (w_low, w_high) = (low.2 * low.2, high.2 * high.2);
-    let mean = |a: f64, b: f64| (w_low * a + w_high * b) / (w_low + w_high);
-    let (freq_hz, decay_per_s) = (mean(low.0, high.0), mean(low.1, high.1));
-    // Keeping either mode alone would land 18 Hz or more away, and its decay 30% or more off.
-    assert!(
-        (near[0].freq_hz - freq_hz).abs() < 6.0,
-        "merged at {} Hz, the pair's weighted mean is {freq_hz} Hz",
-        near[0].freq_hz
-    );
-    assert!(
-        (near[0].decay_per_s / decay_per_s - 1.0).abs() < 0.2,
-        "merged decay {} /s, the pair's weighted mean is {decay_per_s} /s",
-        near[0].decay_per_s
-    );
-    assert_eq!(fit.bank.modes.len(), 2, "{:?}", fit.bank.modes);
+    assert_eq!(fit.modes.len(), 3, "{:?}", fit.modes);
+}
+
+#[test]
+fn a_fast_then_slow_decay_comes_out_as_two_modes() {
+    // A partial that falls 35 dB in its first 0.2 s, then rings on 25 dB down: the sum of a
+    // fast and a slow mode at nearly one frequency, as a bar's near-degenerate pair gives it.
+    let (fast, slow) = ((2000.0, 40.0, [0.3, 0.2]), (2000.3, 1.5, [0.02, 0.015]));
+    let fit = fit_of(&[(440.0, 2.0, [0.3, 0.2]), fast, slow], 70);
+    let near = modes_near(&fit, 2000.0, 20.0);
+    assert_eq!(near.len(), 2, "modes near 2 kHz: {:?}", fit.modes);
+    let (quick, long) = if near[0].decay_per_s > near[1].decay_per_s {
+        (near[0], near[1])
+    } else {
+        (near[1], near[0])
+    };
+    for (m, want) in [(quick, fast), (long, slow)] {
+        assert!(
+            (m.freq_hz - want.0).abs() < 0.5 && (m.decay_per_s / want.1 - 1.0).abs() < 0.1,
+            "{} Hz, {} /s: found {m:?}",
+            want.0,
+            want.1
+        );
+    }
 }
 
 #[test]

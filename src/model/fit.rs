@@ -16,15 +16,19 @@
 //! positions) change the sound.
 
 mod analyse;
+mod bandfit;
 mod combine;
 mod error;
+mod esprit;
 mod fidelity;
+mod linalg;
 mod lsq;
 mod noise;
 mod onset;
-mod peaks;
+mod refine;
 mod report;
 mod stft;
+mod subband;
 mod track;
 mod warnings;
 mod wav;

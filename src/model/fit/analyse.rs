@@ -1,19 +1,16 @@
-//! The modes of one recording: onset, noise floor, candidates by voting, then rounds of
-//! tracking each mode in what the others leave and solving for all amplitudes together.
-//!
-//! Each round subtracts every other mode's fitted contribution before tracking a mode (the
-//! space-alternating scheme of Fessler and Hero's SAGE), so a weak mode beside a strong one is
-//! measured on its own, and the joint least squares ([`lsq`](super::lsq)) shares the energy of
-//! overlapping modes correctly. After the first round the residual is searched again for modes
-//! the strong ones hid.
+//! The modes of one recording: onset and noise floor, then the sound split into frequency bands
+//! ([`subband`](super::subband)), each band's modes estimated by ESPRIT and refined against the
+//! band's signal, keeping as many as measurably improve its resynthesis
+//! ([`bandfit`](super::bandfit)).
 
 use realfft::num_complex::Complex64;
 
+use super::bandfit::{fit_band, BandMode};
 use super::lsq::{add_modes, fit_amplitudes, Shape};
 use super::noise::NoiseSpectrum;
 use super::onset::{find_strike, Strike};
-use super::peaks::vote;
 use super::stft::{hann, Spectrogram};
+use super::subband::{layout, split};
 use super::track::{track, Track};
 use super::warnings::{check_clipping, input_warnings};
 use super::{FitError, FitOptions, Recording};
@@ -32,9 +29,6 @@ const MIN_WINDOWS_IN_SOUND: usize = 4;
 
 /// Time after the onset left out of the fits, in seconds: the mallet is still in contact.
 const START_SKIP_S: f64 = 0.002;
-
-/// Rounds of tracking and joint amplitude fitting.
-const ROUNDS: usize = 3;
 
 /// Zero-padding of the voting spectrogram.
 const PAD: usize = 2;
@@ -124,8 +118,7 @@ impl Analysis {
 pub fn analyse(recording: &Recording, options: &FitOptions) -> Result<Analysis, FitError> {
     let mut analysis = prepare(recording, options)?;
     let max_hz = options.max_hz(recording.sample_rate_hz);
-    let max_candidates = 3 * options.max_modes + 16;
-    find_modes(&mut analysis, options.min_hz, max_hz, max_candidates);
+    find_modes(&mut analysis, options.min_hz, max_hz);
     drop_steady_tones(&mut analysis);
     Ok(analysis)
 }
@@ -194,76 +187,66 @@ pub fn prepare(recording: &Recording, options: &FitOptions) -> Result<Analysis, 
     })
 }
 
-/// The rounds of voting, tracking and joint fitting.
-fn find_modes(a: &mut Analysis, min_hz: f64, max_hz: f64, max_candidates: usize) {
-    let rate = a.sample_rate_hz;
-    let bin_hz = rate / a.window_len as f64;
-    let first = candidates(a, &a.signal, min_hz, max_hz, max_candidates, &[]);
-    let mut modes: Vec<Found> = first
-        .into_iter()
-        .filter_map(|f| track_in(a, &a.signal, f, a.window_len))
+/// The modes of every band, measured jointly in each and kept by what they add to the
+/// resynthesis, then their amplitudes solved jointly over the whole sound.
+fn find_modes(a: &mut Analysis, min_hz: f64, max_hz: f64) {
+    let bands = split(&a.signal, a.sample_rate_hz, &layout(min_hz, max_hz));
+    let mut found: Vec<BandMode> = bands.iter().flat_map(fit_band).collect();
+    found.sort_by(|x, y| x.freq_hz.total_cmp(&y.freq_hz));
+    let shapes: Vec<Shape> = found
+        .iter()
+        .map(|m| Shape {
+            freq_hz: m.freq_hz,
+            decay_per_s: m.decay_per_s,
+        })
         .collect();
-    dedupe(&mut modes, bin_hz);
-    for round in 0..ROUNDS {
-        let shapes = shapes_of(&modes);
-        let amplitudes = a.amplitudes(&shapes);
-        for (m, c) in modes.iter_mut().zip(&amplitudes) {
-            m.amplitude = *c;
-        }
-        let residual = a.residual(&shapes, &amplitudes);
-        // Modes the strong ones hid: found in the residual, they join the joint fit next round.
-        let hidden: Vec<Found> = if round == 0 {
-            let known: Vec<f64> = modes.iter().map(|m| m.freq_hz).collect();
-            candidates(a, &residual, min_hz, max_hz, max_candidates, &known)
-                .into_iter()
-                .filter_map(|f| track_in(a, &residual, f, a.window_len))
-                .collect()
-        } else {
-            Vec::new()
-        };
-        let mut own = vec![0.0; residual.len()];
-        let tracked: Vec<Found> = modes
-            .iter()
-            .filter_map(|m| {
-                own.copy_from_slice(&residual);
-                add_modes(
-                    &mut own,
-                    rate,
-                    &shapes_of(std::slice::from_ref(m)),
-                    &[m.amplitude],
-                );
-                // A window about one time constant long: shorter for fast decays, so they span
-                // more frames before meeting the noise.
-                let span = (rate / m.decay_per_s.max(1e-3)).log2().floor().exp2() as usize;
-                let len = span.clamp(MIN_WINDOW, a.window_len);
-                let found = track_in(a, &own, m.freq_hz, len)
-                    .or_else(|| track_in(a, &own, m.freq_hz, a.window_len))?;
-                Some(Found {
-                    amplitude: m.amplitude,
-                    ..found
+    let tracks = report_tracks(a, &shapes, &found);
+    a.modes = found
+        .iter()
+        .zip(tracks)
+        .map(|(m, track)| Found {
+            freq_hz: m.freq_hz,
+            decay_per_s: m.decay_per_s,
+            amplitude: m.amplitude,
+            track,
+        })
+        .collect();
+}
+
+/// For the report, each mode followed alone in the recording less every other mode: the frames
+/// its level was measured in and how close they lie to its exponential. A mode too quick or
+/// too weak to follow that way gets the band fit's figures.
+fn report_tracks(a: &Analysis, shapes: &[Shape], found: &[BandMode]) -> Vec<Track> {
+    let amplitudes: Vec<Complex64> = found.iter().map(|m| m.amplitude).collect();
+    let residual = a.residual(shapes, &amplitudes);
+    let mut own = vec![0.0; residual.len()];
+    found
+        .iter()
+        .zip(shapes)
+        .map(|(m, shape)| {
+            own.copy_from_slice(&residual);
+            add_modes(&mut own, a.sample_rate_hz, std::slice::from_ref(shape), &[m.amplitude]);
+            // A window about one time constant long, so a fast decay spans several frames.
+            let span = (a.sample_rate_hz / m.decay_per_s.max(1e-3)).log2().floor().exp2() as usize;
+            let len = span.clamp(MIN_WINDOW, a.window_len);
+            let density = a.noise_density(m.freq_hz);
+            track(&own, a.sample_rate_hz, a.start, m.freq_hz, len, density)
+                .map(|t| Track {
+                    freq_hz: m.freq_hz,
+                    decay_per_s: m.decay_per_s,
+                    amplitude: m.amplitude.norm(),
+                    ..t
                 })
-            })
-            .filter(|m| m.freq_hz >= min_hz && m.freq_hz <= max_hz)
-            .collect();
-        modes = tracked;
-        modes.extend(hidden);
-        dedupe(&mut modes, bin_hz);
-    }
-    let shapes = shapes_of(&modes);
-    let amplitudes = a.amplitudes(&shapes);
-    for (m, c) in modes.iter_mut().zip(&amplitudes) {
-        m.amplitude = *c;
-    }
-    let before = modes.len();
-    modes.retain(|m| m.amplitude.norm() >= a.floor_amplitude(m.freq_hz));
-    if modes.len() < before {
-        let shapes = shapes_of(&modes);
-        let amplitudes = a.amplitudes(&shapes);
-        for (m, c) in modes.iter_mut().zip(&amplitudes) {
-            m.amplitude = *c;
-        }
-    }
-    a.modes = modes;
+                .unwrap_or(Track {
+                    freq_hz: m.freq_hz,
+                    decay_per_s: m.decay_per_s,
+                    amplitude: m.amplitude.norm(),
+                    frames: m.samples,
+                    rms_error_db: 0.0,
+                    snr_db: m.snr_db,
+                })
+        })
+        .collect()
 }
 
 /// Leaves out the modes that hardly decay over the whole recording, with a warning for each:
@@ -292,72 +275,6 @@ fn drop_steady_tones(a: &mut Analysis) {
         .zip(amplitudes)
         .map(|(m, amplitude)| Found { amplitude, ..m })
         .collect();
-}
-
-/// Frequencies voted for in `signal` between `min_hz` and `max_hz`, leaving out those within
-/// one bin of a `known` frequency.
-fn candidates(
-    a: &Analysis,
-    signal: &[f64],
-    min_hz: f64,
-    max_hz: f64,
-    max_candidates: usize,
-    known: &[f64],
-) -> Vec<f64> {
-    let hop = a.window_len / 4;
-    let from = a.start.min(signal.len());
-    let spec = Spectrogram::new(&signal[from..], a.sample_rate_hz, a.window_len, hop, PAD);
-    let bins = spec.bin_of(min_hz)..spec.bin_of(max_hz) + 1;
-    let unpadded_bin_hz = spec.bin_hz * PAD as f64;
-    vote(&spec, &a.noise, 0..spec.power.len(), bins, max_candidates)
-        .into_iter()
-        .map(|c| c.freq_hz)
-        .filter(|f| known.iter().all(|k| (k - f).abs() > unpadded_bin_hz))
-        .collect()
-}
-
-/// Tracks the mode near `freq_hz` in `signal` with a window of `len` samples.
-fn track_in(a: &Analysis, signal: &[f64], freq_hz: f64, len: usize) -> Option<Found> {
-    let t = track(
-        signal,
-        a.sample_rate_hz,
-        a.start,
-        freq_hz,
-        len,
-        a.noise_density(freq_hz),
-    )?;
-    // A track that wandered off to another mode's frequency is not this candidate's.
-    let bin_hz = a.sample_rate_hz / a.window_len as f64;
-    if (t.freq_hz - freq_hz).abs() > 2.0 * bin_hz.max(a.sample_rate_hz / len as f64) {
-        return None;
-    }
-    Some(Found {
-        freq_hz: t.freq_hz,
-        decay_per_s: t.decay_per_s,
-        amplitude: Complex64::new(0.0, -t.amplitude),
-        track: t,
-    })
-}
-
-/// Sorts `modes` by frequency and keeps the stronger of any two closer than one analysis bin:
-/// the same mode found twice (the window cannot tell such a pair apart, so the track of the
-/// stronger already holds both). Pairs the window resolves stay apart here, even within the
-/// difference limen: they are merged when the recordings are combined, which averages their
-/// frequencies and decays and sums their amplitudes (seed 000 section 5.4.1).
-fn dedupe(modes: &mut Vec<Found>, bin_hz: f64) {
-    modes.sort_by(|a, b| a.freq_hz.total_cmp(&b.freq_hz));
-    let mut kept: Vec<Found> = Vec::with_capacity(modes.len());
-    for m in modes.drain(..) {
-        match kept.last_mut() {
-            Some(last) if m.freq_hz - last.freq_hz < bin_hz => {
-                if m.amplitude.norm() > last.amplitude.norm() {
-                    *last = m;
-                }
-            }
-            _ => kept.push(m),
-        }
-    }
-    *modes = kept;
 }
 
 /// The shapes of `modes`, for the least squares.

@@ -1,6 +1,7 @@
-//! One set of modes for all recordings: modes matched across recordings by frequency, modes
-//! closer than the difference limen merged (seed 000 section 5.4.1), and each recording's column
-//! of gains measured for every mode, near zero where the strike did not excite it.
+//! One set of modes for all recordings: modes matched across recordings by frequency (findings in
+//! different recordings closer than the difference limen, seed 000 section 5.4.1, are one mode),
+//! and each recording's column of gains measured for every mode, near zero where the strike did
+//! not excite it.
 //!
 //! Frequencies and decays belong to the object, gains to the strike position (DESIGN.md, the
 //! model): a mode found in any recording is measured in all of them, by the joint least squares
@@ -67,15 +68,25 @@ pub fn combine(analyses: &[Analysis], max_modes: usize) -> Vec<Combined> {
         .collect();
     members.sort_by(|a, b| a.freq_hz.total_cmp(&b.freq_hz));
 
-    // Greedy clusters along the frequency axis: a finding joins the cluster before it when
-    // closer than the limen to the cluster's (weighted) frequency.
+    // Clusters along the frequency axis: a finding joins the nearest cluster closer than the
+    // limen to it that has no finding of its recording yet. Two modes found in one recording
+    // stay two, however close: the analysis resolved them, and a beating pair or a fast-then-slow
+    // decay is heard as such.
     let mut clusters: Vec<Vec<Member>> = Vec::new();
     for m in members {
-        match clusters.last_mut() {
-            Some(c) if m.freq_hz - weighted(c, |x| x.freq_hz) < difference_limen_hz(m.freq_hz) => {
-                c.push(m)
-            }
-            _ => clusters.push(vec![m]),
+        let limen = difference_limen_hz(m.freq_hz);
+        let nearest = clusters
+            .iter()
+            .enumerate()
+            .rev()
+            .take_while(|(_, c)| m.freq_hz - c[0].freq_hz < 2.0 * limen)
+            .filter(|(_, c)| c.iter().all(|x| x.recording != m.recording))
+            .map(|(i, c)| (i, (m.freq_hz - weighted(c, |x| x.freq_hz)).abs()))
+            .filter(|&(_, distance)| distance < limen)
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        match nearest {
+            Some((i, _)) => clusters[i].push(m),
+            None => clusters.push(vec![m]),
         }
     }
     let mut modes: Vec<Combined> = clusters
