@@ -33,9 +33,22 @@ const START_SKIP_S: f64 = 0.002;
 /// Zero-padding of the voting spectrogram.
 const PAD: usize = 2;
 
-/// A mode whose amplitude falls by less than this many nepers (10%) over the recording is a
-/// steady tone, not part of the ring.
-const STEADY_NEPERS: f64 = 0.1;
+/// A mode whose amplitude falls by less than this many nepers (5%) over the whole recording
+/// after the strike does not decay at all: a steady tone, not part of the ring.
+const STEADY_NEPERS: f64 = 0.05;
+
+/// A mode falling by less than this many nepers over the recording is hum when it is already
+/// there before the strike...
+const SLOW_NEPERS: f64 = 1.0;
+
+/// ... at least this share of its amplitude at the strike.
+const BEFORE_SHARE: f64 = 0.5;
+
+/// Longest stretch before the onset kept to look for hum, in seconds.
+const BEFORE_S: f64 = 1.0;
+
+/// Shortest stretch before the onset that can show hum, in seconds.
+const MIN_BEFORE_S: f64 = 0.05;
 
 /// One mode found in a recording.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,6 +82,8 @@ pub struct Analysis {
     pub modes: Vec<Found>,
     /// Warnings for the report.
     pub warnings: Vec<String>,
+    /// Up to [`BEFORE_S`] of the recording before the onset.
+    before: Vec<f64>,
     /// Noise power per bin of the voting spectrogram.
     noise: NoiseSpectrum,
     /// Bin width of the voting spectrogram in Hz.
@@ -175,6 +190,7 @@ pub fn prepare(recording: &Recording, options: &FitOptions) -> Result<Analysis, 
         name: recording.name.clone(),
         sample_rate_hz: rate,
         signal: x[strike.onset..end].to_vec(),
+        before: x[strike.onset.saturating_sub((BEFORE_S * rate) as usize)..strike.onset].to_vec(),
         start: (START_SKIP_S * rate).round() as usize,
         strike,
         window_len,
@@ -249,23 +265,33 @@ fn report_tracks(a: &Analysis, shapes: &[Shape], found: &[BandMode]) -> Vec<Trac
         .collect()
 }
 
-/// Leaves out the modes that hardly decay over the whole recording, with a warning for each:
-/// mains hum, a fan or a whistle, not the object. A struck object's slowest modes still lose more
-/// than 10% of their amplitude over a recording of their ring.
+/// Leaves out hum, with a warning for each tone: a mode that does not decay at all over the
+/// recording, or one that decays slowly and is already there before the strike. A mode that
+/// starts with the strike stays, however slowly it decays: a bell's hum note, a recording cut
+/// short.
 fn drop_steady_tones(a: &mut Analysis) {
     let sound_s = a.signal.len() as f64 / a.sample_rate_hz;
-    let (steady, modes): (Vec<Found>, Vec<Found>) = a
-        .modes
-        .iter()
-        .partition(|m| m.decay_per_s * sound_s < STEADY_NEPERS);
+    let heard_before = (a.before.len() as f64) >= MIN_BEFORE_S * a.sample_rate_hz;
+    let (steady, modes): (Vec<Found>, Vec<Found>) = a.modes.iter().partition(|m| {
+        let nepers = m.decay_per_s * sound_s;
+        let before = heard_before
+            && amplitude_before(a, m.freq_hz) >= BEFORE_SHARE * m.amplitude.norm();
+        (before && nepers < SLOW_NEPERS) || (!heard_before && nepers < STEADY_NEPERS)
+    });
     if steady.is_empty() {
         return;
     }
     for m in &steady {
         a.warnings.push(format!(
-            "steady tone at {:.1} Hz left out: it decays by less than 10% over the {sound_s:.2} s \
-             of sound (hum or background noise?)",
-            m.freq_hz
+            "steady tone at {:.1} Hz left out as hum: it decays by {:.0}% over the {sound_s:.2} s \
+             of sound{}",
+            m.freq_hz,
+            100.0 * (1.0 - (-m.decay_per_s * sound_s).exp()),
+            if heard_before {
+                " and is there before the strike"
+            } else {
+                ""
+            }
         ));
     }
     let shapes = shapes_of(&modes);
@@ -275,6 +301,20 @@ fn drop_steady_tones(a: &mut Analysis) {
         .zip(amplitudes)
         .map(|(m, amplitude)| Found { amplitude, ..m })
         .collect();
+}
+
+/// Amplitude of a sinusoid at `freq_hz` in the recording before the onset (Hann-windowed).
+fn amplitude_before(a: &Analysis, freq_hz: f64) -> f64 {
+    let w = hann(a.before.len());
+    let omega = std::f64::consts::TAU * freq_hz / a.sample_rate_hz;
+    let sum: Complex64 = a
+        .before
+        .iter()
+        .zip(&w)
+        .enumerate()
+        .map(|(n, (x, w))| Complex64::from_polar(x * w, -omega * n as f64))
+        .sum();
+    2.0 * sum.norm() / w.iter().sum::<f64>().max(1e-300)
 }
 
 /// The shapes of `modes`, for the least squares.
