@@ -4,9 +4,12 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use modal_resonator::model::fit::{fit_bank, read_wav_recording, stage_report_file, FitOptions};
+use modal_resonator::model::fit::{
+    fit_bank_with_progress, read_wav_recording, stage_report_file, FitOptions, DEFAULT_MAX_MODES,
+};
 use modal_resonator::model::{commit_all, stage_bank_file};
 
+use super::progress::Progress;
 use super::{check_output_dir, same_file};
 
 /// Arguments of `fit`.
@@ -19,8 +22,9 @@ pub(super) struct FitArgs {
     /// Bank file (JSON) to write.
     #[arg(short, long, value_name = "FILE")]
     output: PathBuf,
-    /// Most modes in the bank: the strongest by energy are kept.
-    #[arg(long, default_value_t = 64)]
+    /// Most modes in the bank: the fit keeps the modes that measurably improve the
+    /// resynthesis, and the strongest by energy of those when there are more.
+    #[arg(long, default_value_t = DEFAULT_MAX_MODES)]
     modes: usize,
     /// Lowest mode frequency searched, in Hz.
     #[arg(long, default_value_t = 20.0)]
@@ -98,7 +102,10 @@ pub(super) fn run(args: &FitArgs) -> Result<(), String> {
         window_s: args.window_ms * 1e-3,
         max_seconds: args.max_seconds,
     };
-    let mut fit = fit_bank(&recordings, &options).map_err(|e| e.to_string())?;
+    let mut progress = Progress::new("fitting");
+    let fit = fit_bank_with_progress(&recordings, &options, |done| progress.set(done));
+    progress.finish();
+    let mut fit = fit.map_err(|e| e.to_string())?;
     fit.bank.author = args.author.clone();
     fit.bank.license = args.license.clone();
     let cannot_write = |path: &std::path::Path, e: std::io::Error| {

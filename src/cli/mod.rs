@@ -6,6 +6,7 @@ mod fit;
 mod info;
 mod list;
 mod play;
+mod progress;
 mod render;
 mod schema;
 mod shape;

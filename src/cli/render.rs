@@ -1,25 +1,17 @@
 //! `modal-resonator render`: notes or a MIDI file through a bank to a WAV file.
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
 
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use modal_resonator::engine::{Controls, PreparedBank};
 use modal_resonator::render::{
     parse_notes, read_midi_file, render, write_wav, BitDepth, Note, RenderSettings,
 };
 
+use super::progress::Progress;
 use super::{check_output_dir, load_bank, same_file};
-
-/// Work after which a progress bar appears, so quick renders print nothing but the summary.
-const PROGRESS_DELAY: Duration = Duration::from_secs(1);
-
-/// Steps of the progress bar.
-const PROGRESS_STEPS: u64 = 1000;
 
 /// Arguments of `render`.
 #[derive(Debug, Args)]
@@ -90,22 +82,10 @@ pub(super) fn run(args: &RenderArgs) -> Result<(), String> {
         ..RenderSettings::default()
     };
 
-    let started = Instant::now();
+    let mut progress = Progress::new("rendering");
     let bank = Arc::new(PreparedBank::new(&bank));
-    let bar = ProgressBar::with_draw_target(Some(PROGRESS_STEPS), ProgressDrawTarget::hidden());
-    bar.set_style(
-        ProgressStyle::with_template("rendering {bar:40} {percent:>3}% {elapsed}")
-            .expect("a valid template"),
-    );
-    let mut show_bar = std::io::stderr().is_terminal();
-    let rendered = render(&bank, &notes, &settings, |done| {
-        if show_bar && started.elapsed() >= PROGRESS_DELAY {
-            bar.set_draw_target(ProgressDrawTarget::stderr());
-            show_bar = false;
-        }
-        bar.set_position((done * PROGRESS_STEPS as f64) as u64);
-    });
-    bar.finish_and_clear();
+    let rendered = render(&bank, &notes, &settings, |done| progress.set(done));
+    let elapsed = progress.finish();
     write_wav(&args.output, &rendered, args.bits, args.rate).map_err(|e| e.to_string())?;
 
     let peak_dbfs = rendered.peak_dbfs();
@@ -119,7 +99,7 @@ pub(super) fn run(args: &RenderArgs) -> Result<(), String> {
         peak_dbfs,
         if clipped { " (clipped)" } else { "" },
         rendered.max_voices,
-        started.elapsed().as_secs_f64(),
+        elapsed.as_secs_f64(),
         if rendered.cut_short {
             ", cut at --max-seconds"
         } else {

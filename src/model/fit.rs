@@ -49,6 +49,11 @@ use self::lsq::Shape;
 use crate::dsp::coeffs::{decay_to_t60_s, MAX_FREQ_RATIO};
 use crate::model::bank::{Bank, Mode, Position};
 
+/// Most modes in a fitted bank by default: a bound, not a target (the fit keeps the modes that
+/// measurably improve the resynthesis), high enough for a bell or a plate, low enough that a
+/// voice stays cheap.
+pub const DEFAULT_MAX_MODES: usize = 200;
+
 /// Highest frequency searched by default, in Hz: the top of hearing.
 pub const DEFAULT_MAX_HZ: f64 = 20_000.0;
 
@@ -87,7 +92,8 @@ impl Recording {
 pub struct FitOptions {
     /// Name of the bank.
     pub name: String,
-    /// Most modes in the bank; the strongest by energy are kept.
+    /// Most modes in the bank: the fit keeps the modes that measurably improve the
+    /// resynthesis, and the strongest by energy of those when there are more.
     pub max_modes: usize,
     /// Lowest mode frequency searched, in Hz.
     pub min_hz: f64,
@@ -108,7 +114,7 @@ impl Default for FitOptions {
     fn default() -> Self {
         Self {
             name: "Fitted bank".to_string(),
-            max_modes: 64,
+            max_modes: DEFAULT_MAX_MODES,
             min_hz: 20.0,
             max_hz: DEFAULT_MAX_HZ,
             noise_floor_db: None,
@@ -177,6 +183,15 @@ pub struct FitResult {
 
 /// Fits a bank to `recordings` of one object, one per strike position.
 pub fn fit_bank(recordings: &[Recording], options: &FitOptions) -> Result<FitResult, FitError> {
+    fit_bank_with_progress(recordings, options, |_| {})
+}
+
+/// [`fit_bank`], telling `progress` the share of the analysis done (0 to 1) as it goes.
+pub fn fit_bank_with_progress(
+    recordings: &[Recording],
+    options: &FitOptions,
+    mut progress: impl FnMut(f64),
+) -> Result<FitResult, FitError> {
     options.check()?;
     if recordings.is_empty() {
         return Err(FitError::NoRecordings);
@@ -192,9 +207,11 @@ pub fn fit_bank(recordings: &[Recording], options: &FitOptions) -> Result<FitRes
             });
         }
     }
+    let count = recordings.len() as f64;
     let analyses = recordings
         .iter()
-        .map(|r| analyse(r, options))
+        .enumerate()
+        .map(|(k, r)| analyse(r, options, &mut |done| progress((k as f64 + done) / count)))
         .collect::<Result<Vec<Analysis>, FitError>>()?;
     let modes_found: usize = analyses.iter().map(|a| a.modes.len()).sum();
     let modes = combine(&analyses, options.max_modes);

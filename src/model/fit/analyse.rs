@@ -130,10 +130,15 @@ impl Analysis {
 }
 
 /// Finds the modes of `recording` within the options' frequency range.
-pub fn analyse(recording: &Recording, options: &FitOptions) -> Result<Analysis, FitError> {
+/// `progress` hears the share of the work done.
+pub fn analyse(
+    recording: &Recording,
+    options: &FitOptions,
+    progress: &mut dyn FnMut(f64),
+) -> Result<Analysis, FitError> {
     let mut analysis = prepare(recording, options)?;
     let max_hz = options.max_hz(recording.sample_rate_hz);
-    find_modes(&mut analysis, options.min_hz, max_hz);
+    find_modes(&mut analysis, options.min_hz, max_hz, progress);
     drop_steady_tones(&mut analysis);
     Ok(analysis)
 }
@@ -205,9 +210,13 @@ pub fn prepare(recording: &Recording, options: &FitOptions) -> Result<Analysis, 
 
 /// The modes of every band, measured jointly in each and kept by what they add to the
 /// resynthesis, then their amplitudes solved jointly over the whole sound.
-fn find_modes(a: &mut Analysis, min_hz: f64, max_hz: f64) {
+fn find_modes(a: &mut Analysis, min_hz: f64, max_hz: f64, progress: &mut dyn FnMut(f64)) {
     let bands = split(&a.signal, a.sample_rate_hz, &layout(min_hz, max_hz));
-    let mut found: Vec<BandMode> = bands.iter().flat_map(fit_band).collect();
+    let mut found: Vec<BandMode> = Vec::new();
+    for (k, band) in bands.iter().enumerate() {
+        found.extend(fit_band(band));
+        progress((k + 1) as f64 / bands.len() as f64);
+    }
     found.sort_by(|x, y| x.freq_hz.total_cmp(&y.freq_hz));
     let shapes: Vec<Shape> = found
         .iter()
@@ -241,9 +250,17 @@ fn report_tracks(a: &Analysis, shapes: &[Shape], found: &[BandMode]) -> Vec<Trac
         .zip(shapes)
         .map(|(m, shape)| {
             own.copy_from_slice(&residual);
-            add_modes(&mut own, a.sample_rate_hz, std::slice::from_ref(shape), &[m.amplitude]);
+            add_modes(
+                &mut own,
+                a.sample_rate_hz,
+                std::slice::from_ref(shape),
+                &[m.amplitude],
+            );
             // A window about one time constant long, so a fast decay spans several frames.
-            let span = (a.sample_rate_hz / m.decay_per_s.max(1e-3)).log2().floor().exp2() as usize;
+            let span = (a.sample_rate_hz / m.decay_per_s.max(1e-3))
+                .log2()
+                .floor()
+                .exp2() as usize;
             let len = span.clamp(MIN_WINDOW, a.window_len);
             let density = a.noise_density(m.freq_hz);
             track(&own, a.sample_rate_hz, a.start, m.freq_hz, len, density)
@@ -274,8 +291,8 @@ fn drop_steady_tones(a: &mut Analysis) {
     let heard_before = (a.before.len() as f64) >= MIN_BEFORE_S * a.sample_rate_hz;
     let (steady, modes): (Vec<Found>, Vec<Found>) = a.modes.iter().partition(|m| {
         let nepers = m.decay_per_s * sound_s;
-        let before = heard_before
-            && amplitude_before(a, m.freq_hz) >= BEFORE_SHARE * m.amplitude.norm();
+        let before =
+            heard_before && amplitude_before(a, m.freq_hz) >= BEFORE_SHARE * m.amplitude.norm();
         (before && nepers < SLOW_NEPERS) || (!heard_before && nepers < STEADY_NEPERS)
     });
     if steady.is_empty() {

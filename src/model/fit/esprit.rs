@@ -41,7 +41,9 @@ pub fn esprit(y: &[Complex64], max_order: usize) -> Option<Estimate> {
     let (values, u) = hermitian_eigen(&mut r, rows);
     // Noise: the median of the lower half of the eigenvalues, each about `vectors` times the
     // noise variance.
-    let noise_eig = values[rows - 1 - (rows / 2) / 2].max(values[0] * 1e-16).max(1e-300);
+    let noise_eig = values[rows - 1 - (rows / 2) / 2]
+        .max(values[0] * 1e-16)
+        .max(1e-300);
     let order = values
         .iter()
         .take_while(|&&v| v > ORDER_FACTOR * noise_eig)

@@ -178,7 +178,10 @@ fn qr_step(a: &mut [Complex64], n: usize, m: usize, shift: Complex64) {
 /// Reduces `a` to upper Hessenberg form by Householder reflections (same eigenvalues).
 fn hessenberg(a: &mut [Complex64], n: usize) {
     for k in 0..n.saturating_sub(2) {
-        let norm = (k + 1..n).map(|i| a[i * n + k].norm_sqr()).sum::<f64>().sqrt();
+        let norm = (k + 1..n)
+            .map(|i| a[i * n + k].norm_sqr())
+            .sum::<f64>()
+            .sqrt();
         if norm < 1e-300 {
             continue;
         }
@@ -291,7 +294,9 @@ mod tests {
         assert!(values.windows(2).all(|w| w[0] >= w[1]), "{values:?}");
         for k in 0..n {
             for i in 0..n {
-                let av: Complex64 = (0..n).map(|j| original[i * n + j] * vectors[j * n + k]).sum();
+                let av: Complex64 = (0..n)
+                    .map(|j| original[i * n + j] * vectors[j * n + k])
+                    .sum();
                 let lv = values[k] * vectors[i * n + k];
                 assert!((av - lv).norm() < 1e-10, "pair {k} row {i}: {av} vs {lv}");
             }

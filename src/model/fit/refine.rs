@@ -313,7 +313,10 @@ mod tests {
                 .min_by(|a, b| (a.z - want.z).norm().total_cmp(&(b.z - want.z).norm()))
                 .unwrap();
             assert!((got.z - want.z).norm() < 1e-5, "{got:?} vs {want:?}");
-            assert!((got.c - want.c).norm() < 1e-3 * want.c.norm() + 1e-4, "{got:?}");
+            assert!(
+                (got.c - want.c).norm() < 1e-3 * want.c.norm() + 1e-4,
+                "{got:?}"
+            );
         }
     }
 }

@@ -119,7 +119,10 @@ fn band(
     let k1 = (((core_hz.1 + margin) / bin_hz).ceil() as usize).clamp(k0 + 1, last_bin + 1);
     let bins = k1 - k0;
     let taper_hz = (1.0 - FLAT_MARGIN) * margin;
-    let flat = (core_hz.0 - FLAT_MARGIN * margin, core_hz.1 + FLAT_MARGIN * margin);
+    let flat = (
+        core_hz.0 - FLAT_MARGIN * margin,
+        core_hz.1 + FLAT_MARGIN * margin,
+    );
     let mut buffer: Vec<Complex64> = (k0..k1)
         .map(|k| {
             let f = k as f64 * bin_hz;
