@@ -2,7 +2,10 @@
 #![allow(dead_code)]
 
 pub mod clap;
+pub mod corpus;
+pub mod decode;
 pub mod recordings;
+pub mod sf2;
 
 use std::sync::Arc;
 
