@@ -4,6 +4,7 @@
 pub mod clap;
 pub mod corpus;
 pub mod decode;
+pub mod fit_score;
 pub mod recordings;
 pub mod sf2;
 
