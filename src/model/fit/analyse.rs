@@ -5,7 +5,7 @@
 
 use realfft::num_complex::Complex64;
 
-use super::bandfit::{fit_band, BandMode};
+use super::bandfit::{dedupe, fit_band, BandMode};
 use super::lsq::{add_modes, fit_amplitudes, Shape};
 use super::noise::NoiseSpectrum;
 use super::onset::{find_strike, Strike};
@@ -14,6 +14,7 @@ use super::subband::{layout, split};
 use super::track::{track, Track};
 use super::warnings::{check_clipping, input_warnings};
 use super::{FitError, FitOptions, Recording};
+use crate::dsp::coeffs::MIN_DECAY_PER_S;
 
 /// Lowest sample rate analysed, in Hz.
 pub const MIN_SAMPLE_RATE_HZ: u32 = 8_000;
@@ -43,6 +44,9 @@ const SLOW_NEPERS: f64 = 1.0;
 
 /// ... at least this share of its amplitude at the strike.
 const BEFORE_SHARE: f64 = 0.5;
+
+/// A mode with this many dB less energy than the strongest is left out.
+const INAUDIBLE_DB: f64 = 90.0;
 
 /// Longest stretch before the onset kept to look for hum, in seconds.
 const BEFORE_S: f64 = 1.0;
@@ -214,10 +218,11 @@ fn find_modes(a: &mut Analysis, min_hz: f64, max_hz: f64, progress: &mut dyn FnM
     let bands = split(&a.signal, a.sample_rate_hz, &layout(min_hz, max_hz));
     let mut found: Vec<BandMode> = Vec::new();
     for (k, band) in bands.iter().enumerate() {
-        found.extend(fit_band(band));
+        found.extend(fit_band(band, k));
         progress((k + 1) as f64 / bands.len() as f64);
     }
-    found.sort_by(|x, y| x.freq_hz.total_cmp(&y.freq_hz));
+    dedupe(&mut found);
+    drop_inaudible(&mut found);
     let shapes: Vec<Shape> = found
         .iter()
         .map(|m| Shape {
@@ -236,6 +241,19 @@ fn find_modes(a: &mut Analysis, min_hz: f64, max_hz: f64, progress: &mut dyn FnM
             track,
         })
         .collect();
+}
+
+/// Leaves out modes whose energy (seed 000 eq. 5.15) is more than [`INAUDIBLE_DB`] below the
+/// strongest mode's: a rounding error of the fit, never heard beside it.
+fn drop_inaudible(modes: &mut Vec<BandMode>) {
+    let energy = |m: &BandMode| {
+        let w = std::f64::consts::TAU * m.freq_hz;
+        let d = m.decay_per_s.max(MIN_DECAY_PER_S);
+        0.25 * w * w * m.amplitude.norm_sqr() / (d * (d * d + w * w))
+    };
+    let loudest = modes.iter().map(energy).fold(0.0, f64::max);
+    let floor = loudest * 10f64.powf(-INAUDIBLE_DB / 10.0);
+    modes.retain(|m| energy(m) >= floor);
 }
 
 /// For the report, each mode followed alone in the recording less every other mode: the frames

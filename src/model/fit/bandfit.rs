@@ -23,6 +23,19 @@ const SMOOTH_S: f64 = 0.01;
 /// The fit ends where the band's running power stays below this many times its noise's.
 const END_ABOVE_NOISE: f64 = 2.0;
 
+/// Share of its core's width beyond either edge of the core within which a band keeps the modes
+/// it finds: a mode on the boundary of two cores is kept by both, and [`dedupe`] keeps one. It
+/// stays inside the untapered part of the band (see [`subband`](super::subband)), where the
+/// band filter's smear of the onset does not reach.
+const CORE_REACH: f64 = 0.25;
+
+/// Two findings in neighbouring bands are the same mode when their frequencies differ by less
+/// than this many Hz...
+const SAME_MODE_HZ: f64 = 0.1;
+
+/// ... or less than this share of the modes' bandwidth, `d / pi`.
+const SAME_MODE_BANDWIDTHS: f64 = 0.05;
+
 /// A mode measured in a band.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BandMode {
@@ -36,10 +49,36 @@ pub struct BandMode {
     pub samples: usize,
     /// Amplitude of the mode where the fit starts over the band's noise, in dB.
     pub snr_db: f64,
+    /// Index of the band it was found in.
+    pub band: usize,
+    /// Distance of the mode from the centre of its band's core, in core widths.
+    pub off_centre: f64,
 }
 
-/// The modes whose frequencies lie in the core of `band`.
-pub fn fit_band(band: &Band) -> Vec<BandMode> {
+/// Sorts `modes` by frequency and keeps one of each mode found in two neighbouring bands: the
+/// one nearer its band's centre.
+pub fn dedupe(modes: &mut Vec<BandMode>) {
+    modes.sort_by(|a, b| a.freq_hz.total_cmp(&b.freq_hz));
+    let mut kept: Vec<BandMode> = Vec::with_capacity(modes.len());
+    for m in modes.drain(..) {
+        let bandwidth_hz = (m.decay_per_s + kept.last().map_or(0.0, |l| l.decay_per_s))
+            / (2.0 * std::f64::consts::PI);
+        let tolerance = SAME_MODE_HZ.max(SAME_MODE_BANDWIDTHS * bandwidth_hz);
+        match kept.last_mut() {
+            Some(last) if m.freq_hz - last.freq_hz < tolerance && m.band != last.band => {
+                if m.off_centre < last.off_centre {
+                    *last = m;
+                }
+            }
+            _ => kept.push(m),
+        }
+    }
+    *modes = kept;
+}
+
+/// The modes whose frequencies lie in the core of `band` (or near it, see [`CORE_REACH`]);
+/// `index` tells the band apart from others.
+pub fn fit_band(band: &Band, index: usize) -> Vec<BandMode> {
     let y = &band.samples;
     if y.len() < band.first + MIN_SAMPLES {
         return Vec::new();
@@ -70,12 +109,21 @@ pub fn fit_band(band: &Band) -> Vec<BandMode> {
         })
         .collect();
     target.amplitudes(&mut modes);
+    let dbg: Vec<(f64, f64)> = modes.iter().map(|m| band.mode_of_pole(m.z)).collect();
     let (kept, _) = target.select(modes);
+    if std::env::var("FIT_DEBUG").is_ok() {
+        eprintln!(
+            "band {:?} first {} end {} len {} noise {:e} start {:?} kept {:?}",
+            band.core_hz, band.first, end, y.len(), estimate.noise_var, dbg,
+            kept.iter().map(|m| (band.mode_of_pole(m.z), m.c.norm())).collect::<Vec<_>>()
+        );
+    }
     let noise = estimate.noise_var.sqrt().max(1e-300);
     kept.iter()
         .filter_map(|m| {
             let (freq_hz, decay_per_s) = band.mode_of_pole(m.z);
-            let inside = freq_hz >= band.core_hz.0 && freq_hz < band.core_hz.1;
+            let reach = CORE_REACH * (band.core_hz.1 - band.core_hz.0);
+            let inside = freq_hz >= band.core_hz.0 - reach && freq_hz < band.core_hz.1 + reach;
             let level = (m.c * m.z.powu(band.first as u32)).norm();
             (inside && level > 0.0).then(|| BandMode {
                 freq_hz,
@@ -84,6 +132,9 @@ pub fn fit_band(band: &Band) -> Vec<BandMode> {
                 amplitude: 2.0 * m.c,
                 samples: end - band.first,
                 snr_db: 20.0 * (level / noise).log10(),
+                band: index,
+                off_centre: (freq_hz - 0.5 * (band.core_hz.0 + band.core_hz.1)).abs()
+                    / (band.core_hz.1 - band.core_hz.0),
             })
         })
         .collect()

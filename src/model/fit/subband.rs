@@ -24,14 +24,14 @@ const RELATIVE_CORE: f64 = 0.12;
 
 /// Each band reaches this many core widths beyond its core on either side: modes near a core's
 /// edge are measured whole, and only the outer half of the margin is tapered.
-const MARGIN_CORES: f64 = 0.75;
+const MARGIN_CORES: f64 = 1.0;
 
 /// Share of the margin left untapered, next to the core.
-const FLAT_MARGIN: f64 = 0.33;
+const FLAT_MARGIN: f64 = 0.4;
 
 /// Samples left out at the start of a band, in units of the inverse taper width: the band filter
 /// smears the abrupt start of the sound over about that long.
-const SETTLE_TAPERS: f64 = 1.5;
+const SETTLE_TAPERS: f64 = 2.0;
 
 /// One band of a recording.
 #[derive(Debug, Clone)]
@@ -44,7 +44,8 @@ pub struct Band {
     pub dt_s: f64,
     /// First sample clear of the band filter's smear of the onset.
     pub first: usize,
-    /// The band's signal, sample 0 at the onset, up to the end of the sound.
+    /// The band's signal, sample 0 at the onset, up to the end of the sound (less the stretch
+    /// the band filter smears there).
     pub samples: Vec<Complex64>,
 }
 
@@ -138,9 +139,11 @@ fn band(
     let inverse: Arc<dyn Fft<f64>> = planner.plan_fft_inverse(bins);
     inverse.process(&mut buffer);
     let dt_s = 1.0 / (bins as f64 * bin_hz);
-    let end = ((len as f64 * bins as f64 / fft_len as f64).ceil() as usize).min(bins);
-    buffer.truncate(end);
+    // The band filter smears the end of the recording too, where a sound cut short stops
+    // abruptly: that stretch is left out as the start is.
     let first = (SETTLE_TAPERS / (taper_hz * dt_s)).ceil() as usize;
+    let end = ((len as f64 * bins as f64 / fft_len as f64) as usize).min(bins);
+    buffer.truncate(end.saturating_sub(first));
     Band {
         core_hz,
         base_hz: k0 as f64 * bin_hz,
