@@ -14,7 +14,6 @@ use super::subband::{layout, split};
 use super::track::{track, Track};
 use super::warnings::{check_clipping, input_warnings};
 use super::{FitError, FitOptions, Recording};
-use crate::dsp::coeffs::MIN_DECAY_PER_S;
 
 /// Lowest sample rate analysed, in Hz.
 pub const MIN_SAMPLE_RATE_HZ: u32 = 8_000;
@@ -63,6 +62,8 @@ pub struct Found {
     pub decay_per_s: f64,
     /// Complex amplitude at the onset from the joint fit (`-i a` for `a sin(w t)`).
     pub amplitude: Complex64,
+    /// Signed gain at the strike, as the bank holds it.
+    pub gain: f64,
     /// The last tracking of the mode: frames used and how well they fit.
     pub track: Track,
 }
@@ -222,7 +223,7 @@ fn find_modes(a: &mut Analysis, min_hz: f64, max_hz: f64, progress: &mut dyn FnM
         progress((k + 1) as f64 / bands.len() as f64);
     }
     dedupe(&mut found);
-    drop_inaudible(&mut found);
+    drop_inaudible(&mut found, a.signal.len() as f64 / a.sample_rate_hz);
     let shapes: Vec<Shape> = found
         .iter()
         .map(|m| Shape {
@@ -238,18 +239,19 @@ fn find_modes(a: &mut Analysis, min_hz: f64, max_hz: f64, progress: &mut dyn FnM
             freq_hz: m.freq_hz,
             decay_per_s: m.decay_per_s,
             amplitude: m.amplitude,
+            gain: m.gain,
             track,
         })
         .collect();
 }
 
-/// Leaves out modes whose energy (seed 000 eq. 5.15) is more than [`INAUDIBLE_DB`] below the
+/// Leaves out modes whose energy over the sound is more than [`INAUDIBLE_DB`] below the
 /// strongest mode's: a rounding error of the fit, never heard beside it.
-fn drop_inaudible(modes: &mut Vec<BandMode>) {
+fn drop_inaudible(modes: &mut Vec<BandMode>, sound_s: f64) {
+    // The energy of a |a| exp(-d t) envelope over the sound: |a|^2 (1 - exp(-2 d T)) / (2 d).
     let energy = |m: &BandMode| {
-        let w = std::f64::consts::TAU * m.freq_hz;
-        let d = m.decay_per_s.max(MIN_DECAY_PER_S);
-        0.25 * w * w * m.amplitude.norm_sqr() / (d * (d * d + w * w))
+        let d = m.decay_per_s.max(1e-9);
+        m.amplitude.norm_sqr() * -(-2.0 * d * sound_s).exp_m1() / (2.0 * d)
     };
     let loudest = modes.iter().map(energy).fold(0.0, f64::max);
     let floor = loudest * 10f64.powf(-INAUDIBLE_DB / 10.0);
@@ -329,13 +331,7 @@ fn drop_steady_tones(a: &mut Analysis) {
             }
         ));
     }
-    let shapes = shapes_of(&modes);
-    let amplitudes = a.amplitudes(&shapes);
-    a.modes = modes
-        .into_iter()
-        .zip(amplitudes)
-        .map(|(m, amplitude)| Found { amplitude, ..m })
-        .collect();
+    a.modes = modes;
 }
 
 /// Amplitude of a sinusoid at `freq_hz` in the recording before the onset (Hann-windowed).
@@ -352,13 +348,3 @@ fn amplitude_before(a: &Analysis, freq_hz: f64) -> f64 {
     2.0 * sum.norm() / w.iter().sum::<f64>().max(1e-300)
 }
 
-/// The shapes of `modes`, for the least squares.
-pub fn shapes_of(modes: &[Found]) -> Vec<Shape> {
-    modes
-        .iter()
-        .map(|m| Shape {
-            freq_hz: m.freq_hz,
-            decay_per_s: m.decay_per_s,
-        })
-        .collect()
-}

@@ -4,7 +4,7 @@
 use realfft::num_complex::Complex64;
 
 use super::esprit::{esprit, MIN_SAMPLES};
-use super::refine::{Exp, Target};
+use super::refine::{Exp, Modes, Target};
 use super::subband::Band;
 
 /// Most modes a band may hold (its core spans about two semitones).
@@ -43,8 +43,11 @@ pub struct BandMode {
     pub freq_hz: f64,
     /// Decay rate in 1/s.
     pub decay_per_s: f64,
-    /// Complex amplitude at the onset, as the least squares gives it: `x = Re(c exp(s t))`.
+    /// Complex amplitude at the onset: `x = Re(c exp(s t))`.
     pub amplitude: Complex64,
+    /// Signed gain at the strike, which the band's fit places a little after or before the
+    /// onset: `a exp(-d (t - t_s)) sin(w (t - t_s))`.
+    pub gain: f64,
     /// Samples of the band the mode was fitted over.
     pub samples: usize,
     /// Amplitude of the mode where the fit starts over the band's noise, in dB.
@@ -94,42 +97,39 @@ pub fn fit_band(band: &Band, index: usize) -> Vec<BandMode> {
     let end = sound_end(y, band.first, smooth, estimate.noise_var)
         .min(band.first + MAX_FIT_SAMPLES)
         .max(band.first + MIN_SAMPLES);
-    let target = Target::new(y, band.first..end, estimate.noise_var, smooth);
-    let max_magnitude = (-1e-6f64).exp();
-    let mut modes: Vec<Exp> = estimate
-        .poles
-        .iter()
-        .map(|&z| Exp {
-            z: if z.norm() > max_magnitude {
-                z / z.norm() * max_magnitude
-            } else {
-                z
-            },
-            c: Complex64::new(0.0, 0.0),
-        })
-        .collect();
-    target.amplitudes(&mut modes);
-    let dbg: Vec<(f64, f64)> = modes.iter().map(|m| band.mode_of_pole(m.z)).collect();
-    let (kept, _) = target.select(modes);
-    if std::env::var("FIT_DEBUG").is_ok() {
-        eprintln!(
-            "band {:?} first {} end {} len {} noise {:e} start {:?} kept {:?}",
-            band.core_hz, band.first, end, y.len(), estimate.noise_var, dbg,
-            kept.iter().map(|m| (band.mode_of_pole(m.z), m.c.norm())).collect::<Vec<_>>()
-        );
-    }
+    let beta = std::f64::consts::TAU * band.base_hz * band.dt_s;
+    let target = Target::new(y, band.first..end, estimate.noise_var, smooth, beta);
+    let magnitudes = target.min_log_magnitude().exp()..=(-1e-6f64).exp();
+    let mut start = Modes {
+        modes: estimate
+            .poles
+            .iter()
+            .map(|&z| Exp {
+                z: z / z.norm() * z.norm().clamp(*magnitudes.start(), *magnitudes.end()),
+                gain: 0.0,
+            })
+            .collect(),
+        tau: 0.0,
+    };
+    target.gains(&mut start);
+    let (kept, _) = target.select(start);
     let noise = estimate.noise_var.sqrt().max(1e-300);
-    kept.iter()
+    let delay_s = kept.tau * band.dt_s;
+    kept.modes
+        .iter()
         .filter_map(|m| {
             let (freq_hz, decay_per_s) = band.mode_of_pole(m.z);
             let reach = CORE_REACH * (band.core_hz.1 - band.core_hz.0);
             let inside = freq_hz >= band.core_hz.0 - reach && freq_hz < band.core_hz.1 + reach;
-            let level = (m.c * m.z.powu(band.first as u32)).norm();
-            (inside && level > 0.0).then(|| BandMode {
+            // a exp(-d (t - t_s)) sin(w (t - t_s)) is Re(c exp((-d + i w) t)) with this c.
+            let pole_s = Complex64::new(-decay_per_s, std::f64::consts::TAU * freq_hz);
+            let amplitude = Complex64::new(0.0, -m.gain) * (-pole_s * delay_s).exp();
+            let level = 0.5 * m.gain.abs() * (-decay_per_s * (band.first as f64 * band.dt_s - delay_s)).exp();
+            (inside && m.gain != 0.0).then(|| BandMode {
                 freq_hz,
                 decay_per_s,
-                // The band holds half the real mode (its positive frequency).
-                amplitude: 2.0 * m.c,
+                amplitude,
+                gain: m.gain,
                 samples: end - band.first,
                 snr_db: 20.0 * (level / noise).log10(),
                 band: index,

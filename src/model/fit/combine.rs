@@ -48,6 +48,8 @@ struct Member {
     weight: f64,
     /// The finding's track.
     track: Track,
+    /// Its signed gain at the strike in its recording.
+    gain: f64,
 }
 
 /// The bank's modes from the modes of every recording: at most `max_modes`, the strongest by
@@ -62,6 +64,7 @@ pub fn combine(analyses: &[Analysis], max_modes: usize) -> Vec<Combined> {
                 freq_hz: m.freq_hz,
                 decay_per_s: m.decay_per_s,
                 weight: (m.amplitude.norm() / a.floor_amplitude(m.freq_hz)).powi(2),
+                gain: m.gain,
                 track: m.track,
             })
         })
@@ -109,14 +112,23 @@ pub fn combine(analyses: &[Analysis], max_modes: usize) -> Vec<Combined> {
         })
         .collect();
 
-    measure_gains(analyses, &mut modes);
+    if analyses.len() == 1 {
+        // One recording: the gains its analysis measured, each mode with the strike's phase.
+        for (m, c) in modes.iter_mut().zip(&clusters) {
+            m.gains = vec![c[0].gain];
+        }
+    } else {
+        measure_gains(analyses, &mut modes);
+    }
     modes.retain(|m| m.gains.iter().any(|&g| g != 0.0));
     if modes.len() > max_modes {
         modes.sort_by(|a, b| energy(b).total_cmp(&energy(a)));
         modes.truncate(max_modes);
         modes.sort_by(|a, b| a.freq_hz.total_cmp(&b.freq_hz));
         // Without the dropped modes the kept ones take back the energy they shared.
-        measure_gains(analyses, &mut modes);
+        if analyses.len() > 1 {
+            measure_gains(analyses, &mut modes);
+        }
     }
     modes
 }
