@@ -37,6 +37,10 @@ const PAD: usize = 2;
 /// after the strike does not decay at all: a steady tone, not part of the ring.
 const STEADY_NEPERS: f64 = 0.05;
 
+/// Shortest sound, in seconds, over which a mode that does not decay is taken for hum without
+/// hearing it before the strike: over less, a slow mode of the object seems as steady.
+const MIN_STEADY_S: f64 = 3.0;
+
 /// A mode falling by less than this many nepers over the recording is hum when it is already
 /// there before the strike...
 const SLOW_NEPERS: f64 = 1.0;
@@ -313,7 +317,8 @@ fn drop_steady_tones(a: &mut Analysis) {
         let nepers = m.decay_per_s * sound_s;
         let before =
             heard_before && amplitude_before(a, m.freq_hz) >= BEFORE_SHARE * m.amplitude.norm();
-        (before && nepers < SLOW_NEPERS) || (!heard_before && nepers < STEADY_NEPERS)
+        let long_enough = sound_s >= MIN_STEADY_S;
+        (before && nepers < SLOW_NEPERS) || (!heard_before && long_enough && nepers < STEADY_NEPERS)
     });
     if steady.is_empty() {
         return;
@@ -347,4 +352,3 @@ fn amplitude_before(a: &Analysis, freq_hz: f64) -> f64 {
         .sum();
     2.0 * sum.norm() / w.iter().sum::<f64>().max(1e-300)
 }
-

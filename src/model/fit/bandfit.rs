@@ -36,6 +36,9 @@ const SAME_MODE_HZ: f64 = 0.1;
 /// ... or less than this share of the modes' bandwidth, `d / pi`.
 const SAME_MODE_BANDWIDTHS: f64 = 0.05;
 
+/// ... or less than this share of the frequency resolution of the longer of their fits.
+const SAME_MODE_RESOLUTIONS: f64 = 0.5;
+
 /// A mode measured in a band.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BandMode {
@@ -52,6 +55,8 @@ pub struct BandMode {
     pub samples: usize,
     /// Amplitude of the mode where the fit starts over the band's noise, in dB.
     pub snr_db: f64,
+    /// Frequency resolution of the fit, the inverse of its span, in Hz.
+    pub resolution_hz: f64,
     /// Index of the band it was found in.
     pub band: usize,
     /// Distance of the mode from the centre of its band's core, in core widths.
@@ -66,7 +71,12 @@ pub fn dedupe(modes: &mut Vec<BandMode>) {
     for m in modes.drain(..) {
         let bandwidth_hz = (m.decay_per_s + kept.last().map_or(0.0, |l| l.decay_per_s))
             / (2.0 * std::f64::consts::PI);
-        let tolerance = SAME_MODE_HZ.max(SAME_MODE_BANDWIDTHS * bandwidth_hz);
+        let resolution_hz = m
+            .resolution_hz
+            .max(kept.last().map_or(0.0, |l| l.resolution_hz));
+        let tolerance = SAME_MODE_HZ
+            .max(SAME_MODE_BANDWIDTHS * bandwidth_hz)
+            .max(SAME_MODE_RESOLUTIONS * resolution_hz);
         match kept.last_mut() {
             Some(last) if m.freq_hz - last.freq_hz < tolerance && m.band != last.band => {
                 if m.off_centre < last.off_centre {
@@ -124,7 +134,9 @@ pub fn fit_band(band: &Band, index: usize) -> Vec<BandMode> {
             // a exp(-d (t - t_s)) sin(w (t - t_s)) is Re(c exp((-d + i w) t)) with this c.
             let pole_s = Complex64::new(-decay_per_s, std::f64::consts::TAU * freq_hz);
             let amplitude = Complex64::new(0.0, -m.gain) * (-pole_s * delay_s).exp();
-            let level = 0.5 * m.gain.abs() * (-decay_per_s * (band.first as f64 * band.dt_s - delay_s)).exp();
+            let level = 0.5
+                * m.gain.abs()
+                * (-decay_per_s * (band.first as f64 * band.dt_s - delay_s)).exp();
             (inside && m.gain != 0.0).then(|| BandMode {
                 freq_hz,
                 decay_per_s,
@@ -133,6 +145,7 @@ pub fn fit_band(band: &Band, index: usize) -> Vec<BandMode> {
                 samples: end - band.first,
                 snr_db: 20.0 * (level / noise).log10(),
                 band: index,
+                resolution_hz: 1.0 / ((end - band.first) as f64 * band.dt_s),
                 off_centre: (freq_hz - 0.5 * (band.core_hz.0 + band.core_hz.1)).abs()
                     / (band.core_hz.1 - band.core_hz.0),
             })

@@ -38,10 +38,10 @@ const MAX_STRIKE_SHIFT: f64 = 0.5;
 /// A pole never grows: its log-magnitude per sample stays at or below this.
 const MAX_LOG_MAGNITUDE: f64 = -1e-9;
 
-/// Most a mode may decay, in nepers, between the onset and the first sample fitted: a faster
-/// one is not measured there but extrapolated, and its amplitude at the onset could grow
-/// without bound while it fits the band's start.
-pub const MAX_UNSEEN_NEPERS: f64 = 3.0;
+/// Most a mode may decay, in nepers (half its amplitude), between the onset and the first
+/// sample fitted: a faster one is not measured there but extrapolated, and its amplitude at the
+/// onset could grow without bound while it fits the band's start.
+pub const MAX_UNSEEN_NEPERS: f64 = std::f64::consts::LN_2;
 
 /// Two poles closer than this share of a frequency bin of the samples fitted (`1 / N` cycles
 /// per sample), and as close in decay, are one mode to the data.
@@ -331,7 +331,11 @@ impl<'a> Target<'a> {
     fn unresolved(&self, fit: &Modes) -> Option<usize> {
         let modes = &fit.modes;
         let resolution = RESOLUTION_SHARE / self.range.len().max(1) as f64;
-        let peak = self.range.clone().map(|n| self.y[n].norm()).fold(0.0, f64::max);
+        let peak = self
+            .range
+            .clone()
+            .map(|n| self.y[n].norm())
+            .fold(0.0, f64::max);
         let starts = self.unit_starts(fit);
         if let Some(k) =
             (0..modes.len()).find(|&k| (starts[k] * modes[k].gain).norm() > MAX_OVER_PEAK * peak)

@@ -29,6 +29,10 @@ const MARGIN_CORES: f64 = 1.0;
 /// Share of the margin left untapered, next to the core.
 const FLAT_MARGIN: f64 = 0.4;
 
+/// Narrowest taper in Hz: the band filter smears the onset over about its inverse, so a narrow
+/// band at low frequencies still sees a quick decay after a short skip.
+const MIN_TAPER_HZ: f64 = 150.0;
+
 /// Samples left out at the start of a band, in units of the inverse taper width: the band filter
 /// smears the abrupt start of the sound over about that long.
 const SETTLE_TAPERS: f64 = 2.0;
@@ -114,16 +118,15 @@ fn band(
     planner: &mut FftPlanner<f64>,
 ) -> Band {
     let width = core_hz.1 - core_hz.0;
-    let margin = MARGIN_CORES * width;
-    let last_bin = spectrum.len() - 1;
-    let k0 = (((core_hz.0 - margin) / bin_hz).floor().max(0.0) as usize).min(last_bin);
-    let k1 = (((core_hz.1 + margin) / bin_hz).ceil() as usize).clamp(k0 + 1, last_bin + 1);
-    let bins = k1 - k0;
-    let taper_hz = (1.0 - FLAT_MARGIN) * margin;
+    let taper_hz = ((1.0 - FLAT_MARGIN) * MARGIN_CORES * width).max(MIN_TAPER_HZ);
     let flat = (
-        core_hz.0 - FLAT_MARGIN * margin,
-        core_hz.1 + FLAT_MARGIN * margin,
+        core_hz.0 - FLAT_MARGIN * MARGIN_CORES * width,
+        core_hz.1 + FLAT_MARGIN * MARGIN_CORES * width,
     );
+    let last_bin = spectrum.len() - 1;
+    let k0 = (((flat.0 - taper_hz) / bin_hz).floor().max(0.0) as usize).min(last_bin);
+    let k1 = (((flat.1 + taper_hz) / bin_hz).ceil() as usize).clamp(k0 + 1, last_bin + 1);
+    let bins = k1 - k0;
     let mut buffer: Vec<Complex64> = (k0..k1)
         .map(|k| {
             let f = k as f64 * bin_hz;
