@@ -227,6 +227,8 @@ fn find_modes(a: &mut Analysis, min_hz: f64, max_hz: f64, progress: &mut dyn FnM
         progress((k + 1) as f64 / bands.len() as f64);
     }
     dedupe(&mut found);
+    // A band's reach beyond its core stops at the range searched.
+    found.retain(|m| (min_hz..=max_hz).contains(&m.freq_hz));
     drop_inaudible(&mut found, a.signal.len() as f64 / a.sample_rate_hz);
     let shapes: Vec<Shape> = found
         .iter()

@@ -39,6 +39,11 @@ const SAME_MODE_BANDWIDTHS: f64 = 0.05;
 /// ... or less than this share of the frequency resolution of the longer of their fits.
 const SAME_MODE_RESOLUTIONS: f64 = 0.5;
 
+/// Share of the band's settling stretch the refinement still fits: ESPRIT starts after all of
+/// it, where the band holds pure exponentials, but fitting the second half too keeps modes from
+/// summing, before the first sample fitted, to an onset louder than the recording's.
+const FIT_FROM_SETTLE: f64 = 0.5;
+
 /// A mode measured in a band.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BandMode {
@@ -108,7 +113,8 @@ pub fn fit_band(band: &Band, index: usize) -> Vec<BandMode> {
         .min(band.first + MAX_FIT_SAMPLES)
         .max(band.first + MIN_SAMPLES);
     let beta = std::f64::consts::TAU * band.base_hz * band.dt_s;
-    let target = Target::new(y, band.first..end, estimate.noise_var, smooth, beta);
+    let from = (band.first as f64 * FIT_FROM_SETTLE) as usize;
+    let target = Target::new(y, from..end, estimate.noise_var, smooth, beta);
     let magnitudes = target.min_log_magnitude().exp()..=(-1e-6f64).exp();
     let mut start = Modes {
         modes: estimate
