@@ -118,6 +118,11 @@ impl Analysis {
         }
     }
 
+    /// Whether the user gave the noise floor.
+    pub fn floor_given(&self) -> bool {
+        self.floor_override.is_some()
+    }
+
     /// Amplitude of a mode as strong as the noise in one analysis frame near `freq_hz`: the
     /// noise floor in the units of the bank's gains.
     pub fn floor_amplitude(&self, freq_hz: f64) -> f64 {

@@ -44,6 +44,10 @@ const SAME_MODE_RESOLUTIONS: f64 = 0.5;
 /// summing, before the first sample fitted, to an onset louder than the recording's.
 const FIT_FROM_SETTLE: f64 = 0.5;
 
+/// A mode must start, at the band's first clean sample, at least this many times the noise's
+/// RMS: a weaker one is never heard above it and fits the noise or the band filter's smear.
+const MIN_LEVEL_OVER_NOISE: f64 = 2.0;
+
 /// A mode measured in a band.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BandMode {
@@ -143,7 +147,7 @@ pub fn fit_band(band: &Band, index: usize) -> Vec<BandMode> {
             let level = 0.5
                 * m.gain.abs()
                 * (-decay_per_s * (band.first as f64 * band.dt_s - delay_s)).exp();
-            (inside && m.gain != 0.0).then(|| BandMode {
+            (inside && level > MIN_LEVEL_OVER_NOISE * noise).then(|| BandMode {
                 freq_hz,
                 decay_per_s,
                 amplitude,

@@ -113,9 +113,12 @@ pub fn combine(analyses: &[Analysis], max_modes: usize) -> Vec<Combined> {
         .collect();
 
     if analyses.len() == 1 {
-        // One recording: the gains its analysis measured, each mode with the strike's phase.
+        // One recording: the gains its analysis measured, each mode with the strike's phase,
+        // less those under a noise floor the user gave.
+        let a = &analyses[0];
         for (m, c) in modes.iter_mut().zip(&clusters) {
-            m.gains = vec![c[0].gain];
+            let heard = !a.floor_given() || c[0].gain.abs() >= a.floor_amplitude(m.freq_hz);
+            m.gains = vec![if heard { c[0].gain } else { 0.0 }];
         }
     } else {
         measure_gains(analyses, &mut modes);
