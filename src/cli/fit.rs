@@ -32,12 +32,11 @@ pub(super) struct FitArgs {
     /// Highest mode frequency searched, in Hz (never above 0.45 times the sample rate).
     #[arg(long, default_value_t = 20_000.0)]
     max_hz: f64,
-    /// Noise floor in dBFS: the weakest mode amplitude trusted, and where decay fits stop.
-    /// Estimated from each recording when not given.
+    /// Noise floor in dBFS: the weakest mode amplitude kept. Judged band by band from each
+    /// recording when not given.
     #[arg(long, allow_hyphen_values = true, value_name = "DB")]
     noise_floor_db: Option<f64>,
-    /// Analysis window in milliseconds: longer separates closer modes, shorter follows faster
-    /// decays.
+    /// Window of the noise estimate and of the report's per-mode tracks, in milliseconds.
     #[arg(long, default_value_t = 170.0, value_name = "MS")]
     window_ms: f64,
     /// Longest stretch of each recording analysed after the strike, in seconds.

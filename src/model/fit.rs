@@ -1,14 +1,13 @@
 //! Banks from recordings of struck objects (seed 000 sections 3.3 and 6.2, improved).
 //!
-//! One recording per strike position. For each: find the onset and the noise floor
-//! ([`onset`], [`noise`]); vote for spectral peaks weighted by their squared magnitude
-//! ([`stft`], [`peaks`]); track each candidate by complex demodulation, which gives its frequency
-//! far below one bin from the phase and its decay and initial amplitude from the log-magnitude
-//! until it meets the noise floor ([`track`]); solve for every amplitude jointly
-//! ([`lsq`]) and repeat with each mode measured in what the others leave ([`analyse`]). Then
-//! match modes across recordings, merge those closer than the difference limen and measure every
-//! mode's gain in every recording ([`combine`]), and score each recording against the bank
-//! re-synthesised through the engine at its position ([`fidelity`]).
+//! One recording per strike position. For each: find the onset ([`onset`]), split the sound
+//! into frequency bands ([`subband`]), find each band's modes by ESPRIT ([`esprit`]) and refine
+//! them, with the time of the strike, against the band's signal, keeping those that shorten its
+//! description ([`refine`], [`bandfit`]); leave out hum ([`analyse`]). Then match modes across
+//! recordings and measure every mode's gain in every recording ([`combine`]), and score each
+//! recording against the bank re-synthesised through the engine at its position
+//! ([`fidelity`]). The noise spectrum ([`noise`]) and the per-mode tracks ([`track`]) feed the
+//! report.
 //!
 //! Gains are in the bank format's units: the amplitude, in full scale of the recording, of the
 //! mode at the strike, `y_k(t) = sum_n a_nk exp(-d_n t) sin(2 pi f_n t)`. The engine normalises a
@@ -103,8 +102,8 @@ pub struct FitOptions {
     /// Noise floor as the amplitude, in dBFS, of the weakest mode envelope trusted; `None`
     /// estimates it from each recording.
     pub noise_floor_db: Option<f64>,
-    /// Analysis window in seconds (rounded to a power of two of samples): longer separates
-    /// closer modes, shorter follows faster decays.
+    /// Window of the noise estimate and of the report's per-mode tracks, in seconds (rounded
+    /// to a power of two of samples).
     pub window_s: f64,
     /// Longest stretch of each recording analysed after the strike, in seconds.
     pub max_seconds: f64,

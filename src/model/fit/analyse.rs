@@ -30,7 +30,7 @@ const MIN_WINDOWS_IN_SOUND: usize = 4;
 /// Time after the onset left out of the fits, in seconds: the mallet is still in contact.
 const START_SKIP_S: f64 = 0.002;
 
-/// Zero-padding of the voting spectrogram.
+/// Zero-padding of the noise spectrogram.
 const PAD: usize = 2;
 
 /// A mode whose amplitude falls by less than this many nepers (5%) over the whole recording
@@ -79,7 +79,8 @@ pub struct Analysis {
     pub name: String,
     /// Sample rate in Hz.
     pub sample_rate_hz: f64,
-    /// The sound from the onset to where it meets the noise, as f64.
+    /// The sound from the onset to the end of the recording (at most the longest stretch
+    /// analysed), as f64.
     pub signal: Vec<f64>,
     /// First sample of `signal` used by the fits.
     pub start: usize,
@@ -93,9 +94,9 @@ pub struct Analysis {
     pub warnings: Vec<String>,
     /// Up to [`BEFORE_S`] of the recording before the onset.
     before: Vec<f64>,
-    /// Noise power per bin of the voting spectrogram.
+    /// Noise power per bin of the noise spectrogram.
     noise: NoiseSpectrum,
-    /// Bin width of the voting spectrogram in Hz.
+    /// Bin width of the noise spectrogram in Hz.
     bin_hz: f64,
     /// `sum(w)` and `sum(w^2)` of the analysis window.
     window_sums: (f64, f64),
@@ -223,7 +224,7 @@ pub fn prepare(recording: &Recording, options: &FitOptions) -> Result<Analysis, 
 }
 
 /// The modes of every band, measured jointly in each and kept by what they add to the
-/// resynthesis, then their amplitudes solved jointly over the whole sound.
+/// resynthesis; a mode two bands find is kept once.
 fn find_modes(a: &mut Analysis, min_hz: f64, max_hz: f64, progress: &mut dyn FnMut(f64)) {
     let bands = split(&a.signal, a.sample_rate_hz, &layout(min_hz, max_hz));
     let mut found: Vec<BandMode> = Vec::new();
