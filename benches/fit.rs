@@ -38,7 +38,7 @@ mod reference;
 mod sf2;
 
 use corpus::{Ending, Entry};
-use fit_score::{score, FittedMode, Score};
+use fit_score::{fitted_modes, score, Score};
 
 /// Files the quick run scores: short ones, of three packages.
 const QUICK_SLUGS: [&str; 3] = ["claves-freepats", "agogo-high-freepats", "claves-fluid"];
@@ -82,16 +82,7 @@ fn ours(recording: &Recording, options: &FitOptions) -> Outcome {
     match fit_bank(std::slice::from_ref(recording), options) {
         Ok(fit) => {
             let wall_s = start.elapsed().as_secs_f64();
-            let modes: Vec<FittedMode> = fit
-                .bank
-                .modes
-                .iter()
-                .map(|m| FittedMode {
-                    freq_hz: m.freq_hz,
-                    decay_per_s: m.decay_per_s,
-                    gain: m.gains[0],
-                })
-                .collect();
+            let modes = fitted_modes(&fit.bank, 0);
             Outcome::Fitted(score(&modes, recording), modes.len(), wall_s)
         }
         Err(e) => Outcome::Refused(e.to_string()),

@@ -6,7 +6,7 @@
 mod common;
 
 use common::corpus::select;
-use common::fit_score::{score, FittedMode};
+use common::fit_score::{fitted_modes, score};
 use modal_resonator::model::fit::{fit_bank, FitOptions};
 
 /// A recording, the highest score (mean absolute dB over all frames) its fit may reach, and
@@ -64,16 +64,7 @@ fn corpus_recordings_fit_within_their_bounds() {
         let recording = entry.load().unwrap();
         let fit = fit_bank(std::slice::from_ref(&recording), &FitOptions::default())
             .unwrap_or_else(|e| panic!("{}: {e}", case.slug));
-        let modes: Vec<FittedMode> = fit
-            .bank
-            .modes
-            .iter()
-            .map(|m| FittedMode {
-                freq_hz: m.freq_hz,
-                decay_per_s: m.decay_per_s,
-                gain: m.gains[0],
-            })
-            .collect();
+        let modes = fitted_modes(&fit.bank, 0);
         let s = score(&modes, &recording);
         println!(
             "{}: {:.2} dB (bound {}), attack {:.2} dB, tail {:.2} dB, {} modes, {:.1} cents \

@@ -17,6 +17,7 @@
 use std::f64::consts::TAU;
 
 use modal_resonator::model::fit::Recording;
+use modal_resonator::model::Bank;
 use realfft::RealFftPlanner;
 
 /// Onset threshold, relative to the recording's peak.
@@ -56,6 +57,18 @@ pub struct FittedMode {
     pub decay_per_s: f64,
     /// Amplitude at the onset, in the recording's full scale.
     pub gain: f64,
+}
+
+/// The modes of `bank` with their gains at `position`.
+pub fn fitted_modes(bank: &Bank, position: usize) -> Vec<FittedMode> {
+    bank.modes
+        .iter()
+        .map(|m| FittedMode {
+            freq_hz: m.freq_hz,
+            decay_per_s: m.decay_per_s,
+            gain: m.gains[position],
+        })
+        .collect()
 }
 
 /// How close a list of modes comes to a recording.
