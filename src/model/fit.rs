@@ -53,6 +53,10 @@ use crate::model::bank::{Bank, Mode, Position};
 /// voice stays cheap.
 pub const DEFAULT_MAX_MODES: usize = 200;
 
+/// Share of a fit's progress the analyses of the recordings stand for; combining them and the
+/// report take the rest.
+const ANALYSIS_SHARE: f64 = 0.9;
+
 /// Highest frequency searched by default, in Hz: the top of hearing.
 pub const DEFAULT_MAX_HZ: f64 = 20_000.0;
 
@@ -210,7 +214,11 @@ pub fn fit_bank_with_progress(
     let analyses = recordings
         .iter()
         .enumerate()
-        .map(|(k, r)| analyse(r, options, &mut |done| progress((k as f64 + done) / count)))
+        .map(|(k, r)| {
+            analyse(r, options, &mut |done| {
+                progress(ANALYSIS_SHARE * (k as f64 + done) / count)
+            })
+        })
         .collect::<Result<Vec<Analysis>, FitError>>()?;
     let modes_found: usize = analyses.iter().map(|a| a.modes.len()).sum();
     let modes = combine(&analyses, options.max_modes);
@@ -226,6 +234,7 @@ pub fn fit_bank_with_progress(
     }
     let bank = build_bank(recordings, options, &modes);
     let report = build_report(&analyses, options, &modes, &bank, modes_found);
+    progress(1.0);
     Ok(FitResult { bank, report })
 }
 

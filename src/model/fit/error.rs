@@ -129,7 +129,7 @@ impl fmt::Display for FitError {
             } => write!(
                 f,
                 "{name}: only {found_s:.3} s of sound after the strike; at least {needed_s:.3} s \
-                 is needed to measure decays: record until the ring has died away"
+                 is needed to measure decays: record longer after the strike"
             ),
             FitError::NoModes { noise_floor_db } => write!(
                 f,
