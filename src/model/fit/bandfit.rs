@@ -48,6 +48,9 @@ const FIT_FROM_SETTLE: f64 = 0.5;
 /// RMS: a weaker one is never heard above it and fits the noise or the band filter's smear.
 const MIN_LEVEL_OVER_NOISE: f64 = 2.0;
 
+/// A pole whose log-magnitude is within 1% of the lowest allowed is held at that bound.
+const AT_BOUND: f64 = 0.99;
+
 /// A mode measured in a band.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BandMode {
@@ -147,7 +150,10 @@ pub fn fit_band(band: &Band, index: usize) -> Vec<BandMode> {
             let level = 0.5
                 * m.gain.abs()
                 * (-decay_per_s * (band.first as f64 * band.dt_s - delay_s)).exp();
-            (inside && level > MIN_LEVEL_OVER_NOISE * noise).then(|| BandMode {
+            // A pole held at the fastest decay allowed was not measured: the fit pushed it
+            // there to match the band filter's smear of the onset.
+            let measured = m.z.norm().ln() > AT_BOUND * target.min_log_magnitude();
+            (inside && measured && level > MIN_LEVEL_OVER_NOISE * noise).then(|| BandMode {
                 freq_hz,
                 decay_per_s,
                 amplitude,
