@@ -24,7 +24,7 @@ pub const MIN_SAMPLES: usize = 12;
 /// Poles found in a band, and the noise they stand in.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Estimate {
-    /// Poles per sample, strongest subspace direction first.
+    /// Poles per sample, in no particular order.
     pub poles: Vec<Complex64>,
     /// Variance of the noise per complex sample.
     pub noise_var: f64,
