@@ -11,7 +11,9 @@
 //! Run with `cargo bench --bench fit`. From the environment: `FIT_ONLY=slug,slug` (a subset),
 //! `FIT_CORPUS_DIR=DIR` (also write the recordings as WAV files there; empty for
 //! `target/fit-corpus`), and options for the project's fitter: `FIT_MODES`, `FIT_WINDOW_MS`,
-//! `FIT_MAX_SECONDS`, `FIT_NOISE_FLOOR_DB`.
+//! `FIT_MAX_SECONDS`, `FIT_NOISE_FLOOR_DB`. `FIT_SCORE_BANDS=1` prints, for each recording and
+//! fitter, the mean signed difference of the re-synthesis from the recording in each band of
+//! the score, over the attack and the tail: where a fit is too loud or too quiet.
 //!
 //! Without `--bench` (as `cargo test --benches` runs it) it decodes the whole corpus, checks every
 //! checksum and ending, and scores a few short recordings.

@@ -562,7 +562,23 @@ fn a_beating_pair_comes_out_as_two_modes() {
             "{want} Hz, 3 /s: found {m:?}"
         );
     }
-    assert_eq!(fit.modes.len(), 3, "{:?}", fit.modes);
+    // Anything else is faint: a trace of the strike's click or of the noise, 50 dB down.
+    let strongest = fit
+        .modes
+        .iter()
+        .map(|m| m.gains[0].abs())
+        .fold(0.0, f64::max);
+    let others: Vec<&Mode> = fit
+        .modes
+        .iter()
+        .filter(|m| (m.freq_hz - 440.0).abs() > 0.1 && (m.freq_hz - 1000.5).abs() > 0.6)
+        .collect();
+    assert!(
+        others
+            .iter()
+            .all(|m| m.gains.iter().all(|g| db(*g) < db(strongest) - 50.0)),
+        "{others:?}"
+    );
 }
 
 #[test]

@@ -25,22 +25,22 @@ struct Case {
 const CASES: &[Case] = &[
     Case {
         slug: "marimba-c7-fluid",
-        max_all_db: 1.8,
+        max_all_db: 1.6,
         max_cents: 2.0,
     },
     Case {
         slug: "glockenspiel-gs5-freepats",
-        max_all_db: 3.2,
+        max_all_db: 3.0,
         max_cents: 2.0,
     },
     Case {
         slug: "tabla-tun-sonic-pi",
-        max_all_db: 2.1,
+        max_all_db: 2.0,
         max_cents: 5.0,
     },
     Case {
         slug: "claves-freepats",
-        max_all_db: 6.8,
+        max_all_db: 5.6,
         max_cents: 5.0,
     },
     Case {

@@ -213,6 +213,29 @@ pub fn score(modes: &[FittedMode], recording: &Recording) -> Score {
         })
         .collect();
     let offset_db = best_offset_db(&cells, floor);
+    if std::env::var("FIT_SCORE_BANDS").is_ok() {
+        let edges = band_edges_hz(rate);
+        let nb = rec[0].len();
+        for b in 0..nb {
+            let mut acc = [(0.0, 0usize); 2];
+            for (f, (r, s)) in rec.iter().zip(&syn).enumerate() {
+                let (rr, ss) = (r[b].max(floor), (s[b] + offset_db).max(floor));
+                if rr > floor || ss > floor {
+                    let i = usize::from(centres_s[f] >= ATTACK_S);
+                    acc[i].0 += ss - rr;
+                    acc[i].1 += 1;
+                }
+            }
+            eprintln!(
+                "  band {:6.0} Hz attack {:+6.1} ({:3}) tail {:+6.1} ({:4})",
+                edges[b],
+                acc[0].0 / acc[0].1.max(1) as f64,
+                acc[0].1,
+                acc[1].0 / acc[1].1.max(1) as f64,
+                acc[1].1
+            );
+        }
+    }
     let mean = |keep: &dyn Fn(&Cell) -> bool| {
         let chosen: Vec<&Cell> = cells.iter().filter(|c| keep(c)).collect();
         mean_difference_db(chosen.into_iter(), floor, offset_db)

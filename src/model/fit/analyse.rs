@@ -10,7 +10,7 @@ use super::lsq::{add_modes, fit_amplitudes, Shape};
 use super::noise::NoiseSpectrum;
 use super::onset::{find_strike, Strike};
 use super::stft::{hann, Spectrogram};
-use super::subband::{layout, split};
+use super::subband::{layout, Splitter};
 use super::track::{track, Track};
 use super::warnings::{check_clipping, input_warnings};
 use super::{FitError, FitOptions, Recording};
@@ -49,7 +49,7 @@ const SLOW_NEPERS: f64 = 1.0;
 const BEFORE_SHARE: f64 = 0.5;
 
 /// A mode with this many dB less energy than the strongest is left out.
-const INAUDIBLE_DB: f64 = 90.0;
+const INAUDIBLE_DB: f64 = 70.0;
 
 /// Longest stretch before the onset kept to look for hum, in seconds.
 const BEFORE_S: f64 = 1.0;
@@ -226,13 +226,14 @@ pub fn prepare(recording: &Recording, options: &FitOptions) -> Result<Analysis, 
 /// The modes of every band, measured jointly in each and kept by what they add to the
 /// resynthesis; a mode two bands find is kept once.
 fn find_modes(a: &mut Analysis, min_hz: f64, max_hz: f64, progress: &mut dyn FnMut(f64)) {
-    let bands = split(&a.signal, a.sample_rate_hz, &layout(min_hz, max_hz));
+    let cores = layout(min_hz, max_hz);
+    let mut splitter = Splitter::new(&a.signal, a.sample_rate_hz);
     let mut found: Vec<BandMode> = Vec::new();
-    for (k, band) in bands.iter().enumerate() {
-        found.extend(fit_band(band, k));
-        progress((k + 1) as f64 / bands.len() as f64);
+    for (k, &core) in cores.iter().enumerate() {
+        found.extend(fit_band(&mut splitter, core, k));
+        progress((k + 1) as f64 / cores.len() as f64);
     }
-    dedupe(&mut found);
+    dedupe(&mut found, a.signal.len() as f64 / a.sample_rate_hz);
     // A band's reach beyond its core stops at the range searched.
     found.retain(|m| (min_hz..=max_hz).contains(&m.freq_hz));
     drop_inaudible(&mut found, a.signal.len() as f64 / a.sample_rate_hz);

@@ -1,26 +1,44 @@
 //! Analysis by synthesis in one band: every mode's decay, frequency and amplitude, and the time
 //! of the strike, refined together against the band's signal (Levenberg-Marquardt with the
-//! analytic Jacobian of the damped exponentials), and modes kept only while they lower the
-//! description length of the signal (Rissanen's MDL: half the log of the error per sample
-//! against half the log of the samples per parameter).
+//! analytic Jacobian), and modes kept only while they lower the description length of the
+//! signal (Rissanen's MDL: half the log of the error per sample against half the log of the
+//! samples per parameter).
+//!
+//! The model is exact: each mode is synthesised as the band holds it, not as a bare exponential.
+//! A mode `a exp(-d (t - t_s)) sin(w (t - t_s))`, sounding from the first sample of the sound
+//! to its last (where a recording cut short stops it), has a closed-form transform: with
+//! `x_n = Re(c e^(s n))` for `0 <= n < L`, bin `k` of the `N`-point transform holds
+//! `c/2 P(s) + c*/2 P(s*)`, where `P(s) = (1 - (e^s w^k)^L) / (1 - e^s w^k)` and
+//! `w = e^(-2 pi i / N)`. The band tapers those bins and transforms them back, as it does the
+//! recording's ([`subband`](super::subband)). So the fit runs from the band's very first sample:
+//! the band filter's smear of the onset and of the end is part of the model, and quick decays
+//! the smear would hide are measured.
 //!
 //! The modes are those of an impulse at the strike time `t_s`, as the bank plays them: each
-//! `a exp(-d (t - t_s)) sin(w (t - t_s))` with a real, signed gain `a`. Free phases would let
-//! several close modes describe one partial by interfering in ways a bank (whose modes all start
-//! in sine phase) cannot play back. A finite mallet contact delays every mode alike, which the
-//! strike time takes up.
+//! with a real, signed gain `a`. Free phases would let several close modes describe one partial
+//! by interfering in ways a bank (whose modes all start in sine phase) cannot play back. A finite
+//! mallet contact delays every mode alike, which the strike time takes up.
 //!
 //! The error is weighted by the inverse of the band's envelope plus its noise, so that every
 //! stretch of the sound counts alike, as it does to a listener comparing levels in decibels: an
 //! unweighted fit follows the loud start and lets the tail go (a fast-then-slow decay would keep
 //! only its fast part).
 
+use std::f64::consts::TAU;
+use std::sync::Arc;
+
 use realfft::num_complex::Complex64;
+use rustfft::{Fft, FftPlanner};
 
 use super::linalg::solve;
+use super::subband::Band;
 
 /// Iterations of Levenberg-Marquardt.
 const MAX_ITERATIONS: usize = 30;
+
+/// Iterations of Levenberg-Marquardt after each mode the selection drops: the last fit kept is
+/// refined in full.
+const SELECTION_ITERATIONS: usize = 10;
 
 /// Iterations stop once the error falls by less than this share.
 const TOLERANCE: f64 = 1e-7;
@@ -31,35 +49,32 @@ const START_LAMBDA: f64 = 1e-3;
 /// Real parameters per mode: log-magnitude and angle of the pole, and the gain.
 const PARAMS: usize = 3;
 
-/// The strike is found at most this many times the samples left out at the band's start before
-/// or after the onset.
-const MAX_STRIKE_SHIFT: f64 = 0.5;
+/// The strike is found at most this long before or after the onset, in seconds.
+const MAX_STRIKE_SHIFT_S: f64 = 0.001;
 
 /// A pole never grows: its log-magnitude per sample stays at or below this.
 const MAX_LOG_MAGNITUDE: f64 = -1e-9;
 
-/// Most a mode may decay, in nepers (half its amplitude), between the onset and the first
-/// sample fitted: a faster one is not measured there but extrapolated, and its amplitude at the
-/// onset could grow without bound while it fits the band's start.
-pub const MAX_UNSEEN_NEPERS: f64 = std::f64::consts::LN_2;
+/// Fastest decay of a mode, as its bandwidth (`d / pi`) over the width of its band's core: a
+/// quicker one is no longer a resonance of the band but a click spread over several.
+const MAX_BANDWIDTH_CORES: f64 = 2.0;
 
 /// Two poles closer than this share of a frequency bin of the samples fitted (`1 / N` cycles
 /// per sample), and as close in decay, are one mode to the data.
 const RESOLUTION_SHARE: f64 = 0.5;
 
-/// A mode louder where the fit starts than this many times the band's loudest sample is
-/// cancelling another.
+/// A mode louder than this many times the band's loudest sample is cancelling another.
 const MAX_OVER_PEAK: f64 = 2.0;
 
 /// Weight of the parameter count in the description length: 1 is Rissanen's MDL.
 const MDL_PENALTY: f64 = 1.0;
 
-/// A mode of a band: `gain * q * z^(n - tau)`, where `q = -i/2 exp(-i beta tau)` shifts the
-/// band's base frequency `beta` (radians per sample) back over the strike's delay `tau`.
+/// A mode of a band.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Exp {
-    /// Pole per sample, relative to the band's base frequency.
-    pub z: Complex64,
+    /// Logarithm of the pole per sample of the band, its angle counted from the band's base
+    /// frequency (see [`Band::mode_of_log_pole`]).
+    pub s: Complex64,
     /// Signed gain of the mode at the strike, in the recording's full scale.
     pub gain: f64,
 }
@@ -73,81 +88,207 @@ pub struct Modes {
     pub tau: f64,
 }
 
+/// A mode's part of the band, transformed back to the band's samples (over the samples fitted).
+struct Column {
+    /// For a gain of 1.
+    unit: Vec<Complex64>,
+    /// Derivatives by the pole's log-magnitude and angle, for the mode's gain.
+    d_log_magnitude: Vec<Complex64>,
+    d_angle: Vec<Complex64>,
+    /// Derivative of the whole band by the strike time, for this mode's gain.
+    d_tau_bins: Vec<Complex64>,
+}
+
 /// The samples of a band fitted, with their weights.
 pub struct Target<'a> {
-    /// The band's signal.
-    pub y: &'a [Complex64],
+    /// The band.
+    band: &'a Band,
     /// Samples fitted.
     pub range: std::ops::Range<usize>,
     /// Weight of each sample of `range`.
-    pub weights: Vec<f64>,
-    /// The band's base frequency in radians per sample.
-    pub beta: f64,
+    weights: Vec<f64>,
+    /// Inverse transform as long as the band.
+    inverse: Arc<dyn Fft<f64>>,
+    /// Per bin of the band: `w^k` and `w^(k L)`.
+    twiddles: Vec<(Complex64, Complex64)>,
 }
 
 impl<'a> Target<'a> {
-    /// Weights `1 / sqrt(envelope^2 + noise_var)` from a running mean of `|y|^2` over `smooth`
-    /// samples; `beta` is the band's base frequency in radians per sample.
+    /// Fits `band` over `range`, weighted by `1 / sqrt(envelope^2 + noise_var)` from a running
+    /// mean of `|y|^2` over `smooth` samples.
     pub fn new(
-        y: &'a [Complex64],
+        band: &'a Band,
         range: std::ops::Range<usize>,
         noise_var: f64,
         smooth: usize,
-        beta: f64,
     ) -> Self {
+        let y = &band.samples;
         let half = smooth / 2;
-        let power: Vec<f64> = y.iter().map(|v| v.norm_sqr()).collect();
-        let mut prefix = vec![0.0; power.len() + 1];
-        for (i, p) in power.iter().enumerate() {
-            prefix[i + 1] = prefix[i] + p;
+        let mut prefix = vec![0.0; y.len() + 1];
+        for (i, v) in y.iter().enumerate() {
+            prefix[i + 1] = prefix[i] + v.norm_sqr();
         }
         let weights = range
             .clone()
             .map(|n| {
-                let (lo, hi) = (n.saturating_sub(half), (n + half + 1).min(power.len()));
-                let mean = (prefix[hi] - prefix[lo]) / (hi - lo) as f64;
+                let (lo, hi) = (n.saturating_sub(half), (n + half + 1).min(y.len()));
+                let mean = (prefix[hi] - prefix[lo]) / (hi - lo).max(1) as f64;
                 1.0 / (mean + noise_var).max(1e-300).sqrt()
             })
             .collect();
+        let bins = band.taper.len();
+        let n = band.fft_len as f64;
+        let len = band.sound_len as f64;
+        let twiddles = (band.first_bin..band.first_bin + bins)
+            .map(|k| {
+                let k = k as f64;
+                (
+                    Complex64::from_polar(1.0, -TAU * k / n),
+                    Complex64::from_polar(1.0, -TAU * ((k * len) % n) / n),
+                )
+            })
+            .collect();
         Self {
-            y,
+            band,
             range,
             weights,
-            beta,
+            inverse: FftPlanner::new().plan_fft_inverse(bins),
+            twiddles,
         }
     }
 
-    /// Lowest log-magnitude of a pole per sample: see [`MAX_UNSEEN_NEPERS`].
+    /// Lowest log-magnitude of a pole per sample of the band: see [`MAX_BANDWIDTH_CORES`].
     pub fn min_log_magnitude(&self) -> f64 {
-        -MAX_UNSEEN_NEPERS / self.range.start.max(1) as f64
+        let core_hz = self.band.core_hz.1 - self.band.core_hz.0;
+        -std::f64::consts::PI * MAX_BANDWIDTH_CORES * core_hz * self.band.dt_s
     }
 
-    /// Each mode's value at the first sample fitted for a gain of 1: `q z^(start - tau)`.
-    fn unit_starts(&self, fit: &Modes) -> Vec<Complex64> {
-        let q = Complex64::new(0.0, -0.5) * Complex64::from_polar(1.0, -self.beta * fit.tau);
+    /// Highest angle of a pole per sample of the band: the top of its passband. A mode never
+    /// leaves the band, where only the tails of its spectrum would reach the band's samples.
+    fn max_angle(&self) -> f64 {
+        let passband = self.band.taper.iter().rposition(|&t| t > 0.0).unwrap_or(0) + 1;
+        TAU * passband as f64 / self.band.taper.len() as f64
+    }
+
+    /// Most the strike may move from the onset, in samples of the band.
+    fn max_tau(&self) -> f64 {
+        MAX_STRIKE_SHIFT_S / self.band.dt_s
+    }
+
+    /// The pole of `s` per sample of the sound, with its angle in absolute terms.
+    fn full_rate(&self, s: Complex64) -> Complex64 {
+        let scale = self.band.decimation();
+        Complex64::new(
+            s.re / scale,
+            s.im / scale + TAU * self.band.first_bin as f64 / self.band.fft_len as f64,
+        )
+    }
+
+    /// The band's samples over `range` from bins `bins` (consumed).
+    fn back(&self, mut bins: Vec<Complex64>) -> Vec<Complex64> {
+        self.inverse.process(&mut bins);
+        bins.truncate(self.range.end);
+        bins.drain(..self.range.start);
+        bins
+    }
+
+    /// The bins of a mode `m` starting at `tau`: for a gain of 1, and (with `derivatives`) by
+    /// its pole's log-magnitude and angle and by the strike time.
+    fn mode_bins(
+        &self,
+        m: &Exp,
+        tau: f64,
+        derivatives: bool,
+    ) -> (Vec<Complex64>, Option<[Vec<Complex64>; 3]>) {
+        let scale = self.band.decimation();
+        let len = self.band.sound_len as f64;
+        let s = self.full_rate(m.s);
+        let sc = s.conj();
+        let tau_f = tau * scale;
+        let es = s.exp();
+        let esl = Complex64::from_polar((s.re * len).exp(), (s.im * len) % TAU);
+        let q = Complex64::new(0.0, -0.5) * (-s * tau_f).exp();
+        let qc = Complex64::new(0.0, 0.5) * (-sc * tau_f).exp();
+        let one = Complex64::new(1.0, 0.0);
+        let bins = self.twiddles.len();
+        let mut unit = vec![Complex64::new(0.0, 0.0); bins];
+        let mut d = derivatives.then(|| {
+            [
+                vec![Complex64::new(0.0, 0.0); bins],
+                vec![Complex64::new(0.0, 0.0); bins],
+                vec![Complex64::new(0.0, 0.0); bins],
+            ]
+        });
+        // P(a) = (1 - a_L) / (1 - a) with a = e^s w^k, a_L = a^L; dP/ds.
+        let p_and_dp = |a: Complex64, al: Complex64| {
+            let inv = (one - a).inv();
+            let p = (one - al) * inv;
+            (p, (a * p - al * len) * inv)
+        };
+        for (j, (&(w, wl), &t)) in self.twiddles.iter().zip(&self.band.taper).enumerate() {
+            if t == 0.0 {
+                continue;
+            }
+            let (p, dp) = p_and_dp(es * w, esl * wl);
+            let (pc, dpc) = p_and_dp(es.conj() * w, esl.conj() * wl);
+            unit[j] = (q * p + qc * pc) * t;
+            if let Some([dm, da, dt]) = d.as_mut() {
+                let e = q * (dp - p * tau_f);
+                let ec = qc * (dpc - pc * tau_f);
+                dm[j] = (e + ec) * (t / scale);
+                da[j] = Complex64::new(0.0, 1.0) * (e - ec) * (t / scale);
+                dt[j] = -(s * q * p + sc * qc * pc) * (t * scale);
+            }
+        }
+        (unit, d)
+    }
+
+    /// Each mode's part of the band for a gain of 1, over the samples fitted.
+    fn units(&self, fit: &Modes) -> Vec<Vec<Complex64>> {
         fit.modes
             .iter()
-            .map(|m| q * (m.z.ln() * (self.range.start as f64 - fit.tau)).exp())
+            .map(|m| self.back(self.mode_bins(m, fit.tau, false).0))
             .collect()
+    }
+
+    /// Each mode's part of the band and its derivatives, over the samples fitted.
+    fn columns(&self, fit: &Modes) -> Vec<Column> {
+        fit.modes
+            .iter()
+            .map(|m| {
+                let (unit, d) = self.mode_bins(m, fit.tau, true);
+                let [dm, da, dt] = d.expect("derivatives asked for");
+                Column {
+                    unit: self.back(unit),
+                    d_log_magnitude: self.back(dm),
+                    d_angle: self.back(da),
+                    d_tau_bins: dt,
+                }
+            })
+            .collect()
+    }
+
+    /// The model of the band over the samples fitted.
+    fn model(&self, fit: &Modes) -> Vec<Complex64> {
+        let mut bins = vec![Complex64::new(0.0, 0.0); self.twiddles.len()];
+        for m in &fit.modes {
+            let (unit, _) = self.mode_bins(m, fit.tau, false);
+            for (b, u) in bins.iter_mut().zip(unit) {
+                *b += u * m.gain;
+            }
+        }
+        self.back(bins)
     }
 
     /// Weighted squared error of `fit`.
     pub fn error(&self, fit: &Modes) -> f64 {
-        let mut terms: Vec<Complex64> = self
-            .unit_starts(fit)
-            .iter()
-            .zip(&fit.modes)
-            .map(|(u, m)| u * m.gain)
-            .collect();
-        let mut e = 0.0;
-        for (n, w) in self.range.clone().zip(&self.weights) {
-            let model: Complex64 = terms.iter().sum();
-            e += w * w * (self.y[n] - model).norm_sqr();
-            for (t, m) in terms.iter_mut().zip(&fit.modes) {
-                *t *= m.z;
-            }
-        }
-        e
+        let model = self.model(fit);
+        self.range
+            .clone()
+            .zip(&self.weights)
+            .zip(model)
+            .map(|((n, w), m)| w * w * (self.band.samples[n] - m).norm_sqr())
+            .sum()
     }
 
     /// Description length of `modes` modes with error `error`, up to a constant.
@@ -163,20 +304,17 @@ impl<'a> Target<'a> {
         if k == 0 {
             return;
         }
+        let units = self.units(fit);
         let mut gram = vec![Complex64::new(0.0, 0.0); k * k];
         let mut rhs = vec![Complex64::new(0.0, 0.0); k];
-        let mut units = self.unit_starts(fit);
-        for (n, w) in self.range.clone().zip(&self.weights) {
+        for (i, (n, w)) in self.range.clone().zip(&self.weights).enumerate() {
             let w2 = w * w;
             for a in 0..k {
-                let ua = units[a].conj() * w2;
-                rhs[a] += (ua * self.y[n]).re;
+                let ua = units[a][i].conj() * w2;
+                rhs[a] += (ua * self.band.samples[n]).re;
                 for b in a..k {
-                    gram[a * k + b] += (ua * units[b]).re;
+                    gram[a * k + b] += (ua * units[b][i]).re;
                 }
-            }
-            for (u, m) in units.iter_mut().zip(&fit.modes) {
-                *u *= m.z;
             }
         }
         for a in 0..k {
@@ -192,9 +330,15 @@ impl<'a> Target<'a> {
 
     /// Refines every parameter of `fit` together; returns the final weighted error.
     pub fn refine(&self, fit: &mut Modes) -> f64 {
+        self.refine_for(fit, MAX_ITERATIONS)
+    }
+
+    /// Refines every parameter of `fit` together, over at most `iterations`; returns the final
+    /// weighted error.
+    fn refine_for(&self, fit: &mut Modes, iterations: usize) -> f64 {
         let mut error = self.error(fit);
         let mut lambda = START_LAMBDA;
-        for _ in 0..MAX_ITERATIONS {
+        for _ in 0..iterations {
             let (normal, gradient) = self.normal_equations(fit);
             let mut improved = false;
             for _ in 0..8 {
@@ -221,38 +365,36 @@ impl<'a> Target<'a> {
     fn normal_equations(&self, fit: &Modes) -> (Vec<f64>, Vec<f64>) {
         let modes = &fit.modes;
         let dim = PARAMS * modes.len() + 1;
+        let cols = self.columns(fit);
+        let mut tau_bins = vec![Complex64::new(0.0, 0.0); self.twiddles.len()];
+        for (c, m) in cols.iter().zip(modes) {
+            for (b, v) in tau_bins.iter_mut().zip(&c.d_tau_bins) {
+                *b += v * m.gain;
+            }
+        }
+        let d_tau = self.back(tau_bins);
         let mut normal = vec![0.0; dim * dim];
         let mut gradient = vec![0.0; dim];
-        let mut units = self.unit_starts(fit);
-        // d/dtau of z^(n - tau) exp(-i beta tau) is -(ln z + i beta) times it.
-        let tau_factors: Vec<Complex64> = modes
-            .iter()
-            .map(|m| -(m.z.ln() + Complex64::new(0.0, self.beta)))
-            .collect();
         let mut columns = vec![Complex64::new(0.0, 0.0); dim];
-        let i = Complex64::new(0.0, 1.0);
-        for (n, w) in self.range.clone().zip(&self.weights) {
-            let model: Complex64 = units.iter().zip(modes).map(|(u, m)| u * m.gain).sum();
-            let residual = (self.y[n] - model) * *w;
-            let lag = n as f64 - fit.tau;
-            let mut d_tau = Complex64::new(0.0, 0.0);
-            for (k, (u, m)) in units.iter().zip(modes).enumerate() {
-                let term = u * (m.gain * w);
-                columns[PARAMS * k] = term * lag;
-                columns[PARAMS * k + 1] = i * term * lag;
-                columns[PARAMS * k + 2] = u * *w;
-                d_tau += term * tau_factors[k];
+        for (i, (n, &w)) in self.range.clone().zip(&self.weights).enumerate() {
+            let model: Complex64 = cols
+                .iter()
+                .zip(modes)
+                .map(|(c, m)| c.unit[i] * m.gain)
+                .sum();
+            let residual = (self.band.samples[n] - model) * w;
+            for (k, (c, m)) in cols.iter().zip(modes).enumerate() {
+                columns[PARAMS * k] = c.d_log_magnitude[i] * (m.gain * w);
+                columns[PARAMS * k + 1] = c.d_angle[i] * (m.gain * w);
+                columns[PARAMS * k + 2] = c.unit[i] * w;
             }
-            columns[dim - 1] = d_tau;
+            columns[dim - 1] = d_tau[i] * w;
             for a in 0..dim {
                 let ca = columns[a].conj();
                 gradient[a] += (ca * residual).re;
                 for b in a..dim {
                     normal[a * dim + b] += (ca * columns[b]).re;
                 }
-            }
-            for (u, m) in units.iter_mut().zip(modes) {
-                *u *= m.z;
             }
         }
         for a in 0..dim {
@@ -276,19 +418,17 @@ impl<'a> Target<'a> {
             .modes
             .iter()
             .enumerate()
-            .map(|(k, m)| {
-                let s = m.z.ln();
-                let log_mag = (s.re + b[PARAMS * k].re)
-                    .min(MAX_LOG_MAGNITUDE)
-                    .max(self.min_log_magnitude());
-                let angle = s.im + b[PARAMS * k + 1].re;
-                Exp {
-                    z: Complex64::from_polar(log_mag.exp(), angle),
-                    gain: m.gain + b[PARAMS * k + 2].re,
-                }
+            .map(|(k, m)| Exp {
+                s: Complex64::new(
+                    (m.s.re + b[PARAMS * k].re)
+                        .min(MAX_LOG_MAGNITUDE)
+                        .max(self.min_log_magnitude()),
+                    (m.s.im + b[PARAMS * k + 1].re).clamp(0.0, self.max_angle()),
+                ),
+                gain: m.gain + b[PARAMS * k + 2].re,
             })
             .collect();
-        let max_tau = MAX_STRIKE_SHIFT * self.range.start.max(1) as f64;
+        let max_tau = self.max_tau();
         Modes {
             modes,
             tau: (fit.tau + b[dim - 1].re).clamp(-max_tau, max_tau),
@@ -302,7 +442,7 @@ impl<'a> Target<'a> {
         while let Some(k) = self.unresolved(&fit) {
             fit.modes.remove(k);
             self.gains(&mut fit);
-            error = self.refine(&mut fit);
+            error = self.refine_for(&mut fit, SELECTION_ITERATIONS);
         }
         loop {
             if fit.modes.is_empty() {
@@ -318,35 +458,34 @@ impl<'a> Target<'a> {
             self.gains(&mut fewer);
             let e = self.error(&fewer);
             if self.description_length(fewer.modes.len(), e) >= length {
+                let error = self.refine(&mut fit);
                 return (fit, error);
             }
-            error = self.refine(&mut fewer);
+            error = self.refine_for(&mut fewer, SELECTION_ITERATIONS);
             fit = fewer;
         }
     }
 
     /// A mode the data cannot tell from another, if any: the weaker of two poles closer than
-    /// half the resolution of the samples fitted in both frequency and decay, or a mode whose
-    /// level where the fit starts exceeds the band's loudest sample (it cancels another).
+    /// half the resolution of the samples fitted in both frequency and decay, or a mode louder
+    /// than the band's loudest sample (it cancels another).
     fn unresolved(&self, fit: &Modes) -> Option<usize> {
         let modes = &fit.modes;
         let resolution = RESOLUTION_SHARE / self.range.len().max(1) as f64;
         let peak = self
             .range
             .clone()
-            .map(|n| self.y[n].norm())
+            .map(|n| self.band.samples[n].norm())
             .fold(0.0, f64::max);
-        let starts = self.unit_starts(fit);
-        if let Some(k) =
-            (0..modes.len()).find(|&k| (starts[k] * modes[k].gain).norm() > MAX_OVER_PEAK * peak)
-        {
+        let peaks = self.peaks(fit);
+        if let Some(k) = (0..modes.len()).find(|&k| peaks[k] > MAX_OVER_PEAK * peak) {
             return Some(k);
         }
         let energies = self.energies(fit);
         for a in 0..modes.len() {
             for b in a + 1..modes.len() {
-                let (sa, sb) = (modes[a].z.ln(), modes[b].z.ln());
-                let d_angle = (sa.im - sb.im).abs() / std::f64::consts::TAU;
+                let (sa, sb) = (modes[a].s, modes[b].s);
+                let d_angle = (sa.im - sb.im).abs() / TAU;
                 if d_angle < resolution && (sa.re - sb.re).abs() < resolution {
                     return Some(if energies[a] < energies[b] { a } else { b });
                 }
@@ -355,19 +494,27 @@ impl<'a> Target<'a> {
         None
     }
 
+    /// Each mode's loudest sample in the band over the samples fitted.
+    pub fn peaks(&self, fit: &Modes) -> Vec<f64> {
+        self.units(fit)
+            .iter()
+            .zip(&fit.modes)
+            .map(|(u, m)| u.iter().map(|v| v.norm()).fold(0.0, f64::max) * m.gain.abs())
+            .collect()
+    }
+
     /// Weighted energy of each mode over the samples fitted.
     fn energies(&self, fit: &Modes) -> Vec<f64> {
-        self.unit_starts(fit)
+        self.units(fit)
             .iter()
             .zip(&fit.modes)
             .map(|(u, m)| {
-                let mut p = u * m.gain;
-                let mut e = 0.0;
-                for w in &self.weights {
-                    e += w * w * p.norm_sqr();
-                    p *= m.z;
-                }
-                e
+                u.iter()
+                    .zip(&self.weights)
+                    .map(|(v, w)| w * w * v.norm_sqr())
+                    .sum::<f64>()
+                    * m.gain
+                    * m.gain
             })
             .collect()
     }
@@ -375,73 +522,109 @@ impl<'a> Target<'a> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::subband::{layout, split, Splitter};
     use super::*;
     use crate::dsp::rng::Rng;
 
+    /// The model is the band of the modes exactly, from the onset to past the end of a sound
+    /// cut while it rings, in a band taken from a shortened transform too.
+    #[test]
+    fn the_model_is_the_band_of_its_modes() {
+        let rate = 44_100.0;
+        let truth = [
+            (1000.0, 300.0, 0.5),
+            (1040.0, 3.0, -0.1),
+            (1085.0, 40.0, 0.2),
+        ];
+        let delay = 0.3 / rate;
+        let x: Vec<f64> = (0..30_000)
+            .map(|n| {
+                let t = n as f64 / rate - delay;
+                truth
+                    .iter()
+                    .map(|&(f, d, g)| g * (-d * t).exp() * (TAU * f * t).sin())
+                    .sum::<f64>()
+            })
+            .collect();
+        let mut splitter = Splitter::new(&x, rate);
+        for samples in [usize::MAX, 300] {
+            let band = splitter.band((1008.0, 1129.0), samples);
+            let target = Target::new(&band, 0..band.samples.len(), 1e-12, 8);
+            let fit = Modes {
+                modes: truth
+                    .iter()
+                    .map(|&(f, d, g)| Exp {
+                        s: Complex64::new(-d * band.dt_s, TAU * (f - band.base_hz) * band.dt_s),
+                        gain: g,
+                    })
+                    .collect(),
+                tau: delay / band.dt_s,
+            };
+            let peak = band.samples.iter().map(|v| v.norm()).fold(0.0, f64::max);
+            for (n, (m, y)) in target.model(&fit).iter().zip(&band.samples).enumerate() {
+                assert!((m - y).norm() < 1e-9 * peak, "sample {n}: {m} for {y}");
+            }
+        }
+    }
+
+    /// Strikes of known modes, one above its band's centre, with the strike a little after the
+    /// onset, are recovered from the band's first sample.
     #[test]
     fn refinement_recovers_exact_modes_and_selection_drops_a_spurious_one() {
-        let beta = 0.3;
-        let truth = Modes {
-            modes: vec![
-                Exp {
-                    z: Complex64::from_polar(0.99, 0.4),
-                    gain: 1.0,
-                },
-                Exp {
-                    z: Complex64::from_polar(0.9995, 0.41),
-                    gain: -0.1,
-                },
-            ],
-            tau: 0.7,
-        };
+        let rate = 48_000.0;
+        // Frequency in Hz, decay in 1/s, gain.
+        let truth = [
+            (1000.0, 300.0, 0.5),
+            (1040.0, 3.0, -0.1),
+            (1085.0, 40.0, 0.2),
+        ];
+        let delay = 0.4 / rate;
         let mut rng = Rng::new(11);
-        let clean: Vec<Complex64> = {
-            let t = Target::new(&[], 0..0, 1.0, 1, beta);
-            let q = Complex64::new(0.0, -0.5) * Complex64::from_polar(1.0, -beta * truth.tau);
-            let _ = t;
-            (0..800)
-                .map(|n| {
-                    truth
-                        .modes
-                        .iter()
-                        .map(|m| q * m.gain * (m.z.ln() * (n as f64 - truth.tau)).exp())
-                        .sum()
-                })
-                .collect()
-        };
-        let y: Vec<Complex64> = clean
-            .iter()
-            .map(|v| v + Complex64::new(rng.bipolar() as f64, rng.bipolar() as f64) * 1e-4)
+        let x: Vec<f64> = (0..24_000)
+            .map(|n| {
+                let t = n as f64 / rate - delay;
+                truth
+                    .iter()
+                    .map(|&(f, d, g)| g * (-d * t).exp() * (TAU * f * t).sin())
+                    .sum::<f64>()
+                    + 1e-5 * rng.bipolar() as f64
+            })
             .collect();
-        let target = Target::new(&y, 4..y.len(), 1e-8, 16, beta);
+        let bands = split(&x, rate, &layout(900.0, 1200.0));
+        let band = bands
+            .iter()
+            .find(|b| (b.core_hz.0..b.core_hz.1).contains(&1040.0))
+            .unwrap();
+        let target = Target::new(band, 0..band.samples.len(), 1e-10, 8);
+        let guess = |f: f64, d: f64| Exp {
+            s: Complex64::new(-d * band.dt_s, TAU * (f - band.base_hz) * band.dt_s),
+            gain: 0.0,
+        };
         let mut start = Modes {
             modes: truth
-                .modes
                 .iter()
-                .map(|m| Exp {
-                    z: m.z * Complex64::from_polar(0.999, 0.002),
-                    gain: 0.0,
-                })
+                .map(|&(f, d, _)| guess(f + 0.1, d * 1.1))
                 .collect(),
             tau: 0.0,
         };
         // A spurious mode where there is only noise.
-        start.modes.push(Exp {
-            z: Complex64::from_polar(0.95, -1.0),
-            gain: 0.0,
-        });
+        start.modes.push(guess(1060.0, 20.0));
         target.gains(&mut start);
         let (kept, _) = target.select(start);
-        assert_eq!(kept.modes.len(), 2, "{kept:?}");
-        assert!((kept.tau - truth.tau).abs() < 0.05, "{kept:?}");
-        for want in &truth.modes {
+        assert_eq!(kept.modes.len(), 3, "{kept:?}");
+        for &(f, d, g) in &truth {
             let got = kept
                 .modes
                 .iter()
-                .min_by(|a, b| (a.z - want.z).norm().total_cmp(&(b.z - want.z).norm()))
+                .map(|m| (band.mode_of_log_pole(m.s), m.gain))
+                .min_by(|a, b| (a.0 .0 - f).abs().total_cmp(&(b.0 .0 - f).abs()))
                 .unwrap();
-            assert!((got.z - want.z).norm() < 1e-5, "{got:?} vs {want:?}");
-            assert!((got.gain - want.gain).abs() < 1e-3, "{got:?} vs {want:?}");
+            let ((f2, d2), g2) = got;
+            assert!((f2 - f).abs() < 0.01, "{f2} Hz for {f}");
+            assert!((d2 - d).abs() < 0.01 * d, "{d2}/s for {d}");
+            assert!((g2 - g).abs() < 1e-3 * g.abs(), "gain {g2} for {g}");
         }
+        let delay_s = kept.tau * band.dt_s;
+        assert!((delay_s - delay).abs() < 0.05 / rate, "{delay_s} s");
     }
 }

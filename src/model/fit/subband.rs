@@ -2,8 +2,9 @@
 //! a mode is still a decaying complex exponential (Sirdey, Derrien, Kronland-Martinet and
 //! Aramaki, "Modal analysis of impact sounds with ESPRIT in Gabor transforms", DAFx 2011).
 //!
-//! The whole sound after the onset is transformed once; each band takes the bins of its range,
-//! tapered at both ends, and transforms them back with an FFT as long as the band is wide. The
+//! The sound after the onset is transformed once (or a few times, cut shorter for the wide bands,
+//! whose fits span less time); each band takes the bins of its range, tapered at both ends, and
+//! transforms them back with an FFT as long as the band is wide. The
 //! result is the band's part of the signal, shifted down by the band's lowest frequency and
 //! sampled `fs * len / fft_len` times a second: a mode `Re(c exp((-d + i w) t))` inside the band
 //! becomes `(c / 2) exp((-d + i (w - w_base)) t)`. Narrow bands at low frequencies resolve close
@@ -37,6 +38,10 @@ const MIN_TAPER_HZ: f64 = 150.0;
 /// smears the abrupt start of the sound over about that long.
 const SETTLE_TAPERS: f64 = 2.0;
 
+/// Most samples of sound a band holds: a longer sound is cut there (a band's fit spans at most
+/// some 6,000 of its samples, see [`bandfit`](super::bandfit)).
+const MAX_BAND_SAMPLES: usize = 8192;
+
 /// One band of a recording.
 #[derive(Debug, Clone)]
 pub struct Band {
@@ -48,23 +53,35 @@ pub struct Band {
     pub dt_s: f64,
     /// First sample clear of the band filter's smear of the onset.
     pub first: usize,
-    /// The band's signal, sample 0 at the onset, up to the end of the sound (less the stretch
-    /// the band filter smears there).
+    /// The band's signal, sample 0 at the onset, up to the end of the sound and the stretch the
+    /// band filter smears beyond it.
     pub samples: Vec<Complex64>,
+    /// Lowest bin of the sound's spectrum the band takes.
+    pub first_bin: usize,
+    /// Length of the transform of the sound.
+    pub fft_len: usize,
+    /// Samples of sound transformed: the sound stops abruptly there.
+    pub sound_len: usize,
+    /// Gain of each bin taken, the taper over the transform's length.
+    pub taper: Vec<f64>,
 }
 
 impl Band {
     /// Frequency in Hz and decay in 1/s of a pole `z` per sample of this band.
+    #[cfg(test)]
     pub fn mode_of_pole(&self, z: Complex64) -> (f64, f64) {
-        let span_hz = 1.0 / self.dt_s;
-        let mut rel_hz = z.arg() / (TAU * self.dt_s);
-        if rel_hz < 0.0 {
-            rel_hz += span_hz;
-        }
-        (
-            self.base_hz + rel_hz,
-            -z.norm().max(1e-300).ln() / self.dt_s,
-        )
+        self.mode_of_log_pole(log_pole(z))
+    }
+
+    /// Frequency in Hz and decay in 1/s of the pole `exp(s)` per sample of this band, its angle
+    /// `s.im` counted from the band's base frequency.
+    pub fn mode_of_log_pole(&self, s: Complex64) -> (f64, f64) {
+        (self.base_hz + s.im / (TAU * self.dt_s), -s.re / self.dt_s)
+    }
+
+    /// Samples of the sound per sample of this band.
+    pub fn decimation(&self) -> f64 {
+        self.fft_len as f64 / self.taper.len() as f64
     }
 
     /// The pole per sample of this band of a mode at `freq_hz` decaying at `decay_per_s`.
@@ -75,6 +92,16 @@ impl Band {
             TAU * (freq_hz - self.base_hz) * self.dt_s,
         )
     }
+}
+
+/// The logarithm of a pole per sample of a band, its angle in `0..2 pi`: every frequency of a
+/// band lies above its base.
+pub fn log_pole(z: Complex64) -> Complex64 {
+    let angle = z.arg();
+    Complex64::new(
+        z.norm().max(1e-300).ln(),
+        if angle < 0.0 { angle + TAU } else { angle },
+    )
 }
 
 /// The cores of the bands that tile `min_hz..max_hz`.
@@ -89,26 +116,103 @@ pub fn layout(min_hz: f64, max_hz: f64) -> Vec<(f64, f64)> {
     cores
 }
 
-/// The bands of `x` (time 0 at `x[0]`) over `cores`, each holding the sound up to `x.len()`.
+/// Makes the bands of a sound, sharing the transforms of its start among them.
+pub struct Splitter<'a> {
+    /// The sound, time 0 at `x[0]`.
+    x: &'a [f64],
+    /// Its sample rate in Hz.
+    sample_rate_hz: f64,
+    /// Planner of the forward transforms of the sound.
+    real: RealFftPlanner<f64>,
+    /// Planner of the bands' inverse transforms.
+    planner: FftPlanner<f64>,
+    /// Spectra of the start of the sound (half the transform long), by transform length.
+    spectra: Vec<(usize, Vec<Complex64>)>,
+}
+
+impl<'a> Splitter<'a> {
+    /// Bands of `x` at `sample_rate_hz`.
+    pub fn new(x: &'a [f64], sample_rate_hz: f64) -> Self {
+        Self {
+            x,
+            sample_rate_hz,
+            real: RealFftPlanner::new(),
+            planner: FftPlanner::new(),
+            spectra: Vec::new(),
+        }
+    }
+
+    /// The band of `core`, holding at least `samples` of its own samples of sound (at most
+    /// [`MAX_BAND_SAMPLES`]), or all of it when it is shorter.
+    pub fn band(&mut self, core: (f64, f64), samples: usize) -> Band {
+        let (_, taper_hz, _) = shape(core);
+        let span_hz = (1.0 + 2.0 * FLAT_MARGIN * MARGIN_CORES) * (core.1 - core.0) + 2.0 * taper_hz;
+        let samples = samples.min(MAX_BAND_SAMPLES) as f64;
+        let wanted = (samples * self.sample_rate_hz / span_hz).ceil() as usize;
+        let fft_len = (2 * self.x.len().min(wanted)).next_power_of_two().max(64);
+        let len = self.x.len().min(fft_len / 2);
+        let index = match self.spectra.iter().position(|(n, _)| *n == fft_len) {
+            Some(i) => i,
+            None => {
+                let forward = self.real.plan_fft_forward(fft_len);
+                let mut input = forward.make_input_vec();
+                input[..len].copy_from_slice(&self.x[..len]);
+                let mut spectrum = forward.make_output_vec();
+                forward
+                    .process(&mut input, &mut spectrum)
+                    .expect("buffers come from the plan");
+                self.spectra.push((fft_len, spectrum));
+                self.spectra.len() - 1
+            }
+        };
+        let bin_hz = self.sample_rate_hz / fft_len as f64;
+        band(
+            &self.spectra[index].1,
+            bin_hz,
+            fft_len,
+            len,
+            core,
+            &mut self.planner,
+        )
+    }
+}
+
+/// The bands of `x` (time 0 at `x[0]`) over `cores`, each holding as much of the sound as it
+/// can (see [`Splitter::band`]).
+#[cfg(test)]
 pub fn split(x: &[f64], sample_rate_hz: f64, cores: &[(f64, f64)]) -> Vec<Band> {
-    let fft_len = (2 * x.len()).next_power_of_two().max(64);
-    let mut real = RealFftPlanner::<f64>::new();
-    let forward = real.plan_fft_forward(fft_len);
-    let mut input = forward.make_input_vec();
-    input[..x.len()].copy_from_slice(x);
-    let mut spectrum = forward.make_output_vec();
-    forward
-        .process(&mut input, &mut spectrum)
-        .expect("buffers come from the plan");
-    let bin_hz = sample_rate_hz / fft_len as f64;
-    let mut planner = FftPlanner::<f64>::new();
+    let mut splitter = Splitter::new(x, sample_rate_hz);
     cores
         .iter()
-        .map(|&core| band(&spectrum, bin_hz, fft_len, x.len(), core, &mut planner))
+        .map(|&core| splitter.band(core, usize::MAX))
         .collect()
 }
 
-/// One band from the spectrum of the whole sound.
+/// The least `2^a 3^b` at or above `n`.
+fn fast_len(n: usize) -> usize {
+    let mut best = n.next_power_of_two();
+    let mut three = 1;
+    while three < best {
+        let candidate = three * (n.div_ceil(three)).next_power_of_two();
+        best = best.min(candidate);
+        three *= 3;
+    }
+    best
+}
+
+/// The untapered range of the band of `core`, the width of its tapers, and its core's width,
+/// in Hz.
+fn shape(core_hz: (f64, f64)) -> ((f64, f64), f64, f64) {
+    let width = core_hz.1 - core_hz.0;
+    let taper_hz = ((1.0 - FLAT_MARGIN) * MARGIN_CORES * width).max(MIN_TAPER_HZ);
+    let flat = (
+        core_hz.0 - FLAT_MARGIN * MARGIN_CORES * width,
+        core_hz.1 + FLAT_MARGIN * MARGIN_CORES * width,
+    );
+    (flat, taper_hz, width)
+}
+
+/// One band from the spectrum of the sound.
 fn band(
     spectrum: &[Complex64],
     bin_hz: f64,
@@ -117,42 +221,46 @@ fn band(
     core_hz: (f64, f64),
     planner: &mut FftPlanner<f64>,
 ) -> Band {
-    let width = core_hz.1 - core_hz.0;
-    let taper_hz = ((1.0 - FLAT_MARGIN) * MARGIN_CORES * width).max(MIN_TAPER_HZ);
-    let flat = (
-        core_hz.0 - FLAT_MARGIN * MARGIN_CORES * width,
-        core_hz.1 + FLAT_MARGIN * MARGIN_CORES * width,
-    );
+    let (flat, taper_hz, _) = shape(core_hz);
     let last_bin = spectrum.len() - 1;
     let k0 = (((flat.0 - taper_hz) / bin_hz).floor().max(0.0) as usize).min(last_bin);
     let k1 = (((flat.1 + taper_hz) / bin_hz).ceil() as usize).clamp(k0 + 1, last_bin + 1);
-    let bins = k1 - k0;
-    let mut buffer: Vec<Complex64> = (k0..k1)
+    // As many bins as a quick transform takes, those past the band's end at zero gain.
+    let bins = fast_len(k1 - k0);
+    let k1 = k0 + bins;
+    let taper: Vec<f64> = (k0..k1)
         .map(|k| {
             let f = k as f64 * bin_hz;
             let outside = (flat.0 - f).max(f - flat.1).max(0.0) / taper_hz;
-            let gain = if outside >= 1.0 {
+            let gain = if outside >= 1.0 || k > last_bin {
                 0.0
             } else {
                 0.5 + 0.5 * (std::f64::consts::PI * outside).cos()
             };
-            spectrum[k] * (gain / fft_len as f64)
+            gain / fft_len as f64
         })
+        .collect();
+    let mut buffer: Vec<Complex64> = (k0..k1)
+        .zip(&taper)
+        .map(|(k, g)| spectrum.get(k).map_or(Complex64::new(0.0, 0.0), |v| v * g))
         .collect();
     let inverse: Arc<dyn Fft<f64>> = planner.plan_fft_inverse(bins);
     inverse.process(&mut buffer);
     let dt_s = 1.0 / (bins as f64 * bin_hz);
-    // The band filter smears the end of the recording too, where a sound cut short stops
-    // abruptly: that stretch is left out as the start is.
     let first = (SETTLE_TAPERS / (taper_hz * dt_s)).ceil() as usize;
-    let end = ((len as f64 * bins as f64 / fft_len as f64) as usize).min(bins);
-    buffer.truncate(end.saturating_sub(first));
+    // The band filter smears the end of the sound as it does its start.
+    let end = ((len as f64 * bins as f64 / fft_len as f64).ceil() as usize + first).min(bins);
+    buffer.truncate(end);
     Band {
         core_hz,
         base_hz: k0 as f64 * bin_hz,
         dt_s,
         first,
         samples: buffer,
+        first_bin: k0,
+        fft_len,
+        sound_len: len,
+        taper,
     }
 }
 
