@@ -85,7 +85,9 @@ pub struct BandMode {
 }
 
 /// Sorts `modes` by frequency and keeps one of each mode found in two neighbouring bands: the
-/// one nearer its band's centre.
+/// one found in the band whose core holds it, else the one nearer its band's centre. Leaves out
+/// a mode [`MASKED_RATIO`] under an overlapping neighbour from the strike to the end of the
+/// sound (`sound_s` long).
 pub fn dedupe(modes: &mut Vec<BandMode>, sound_s: f64) {
     modes.sort_by(|a, b| a.freq_hz.total_cmp(&b.freq_hz));
     // A mode found outside its band's core is the neighbour's to measure: it stays only when
