@@ -526,37 +526,53 @@ mod tests {
     use super::*;
     use crate::dsp::rng::Rng;
 
+    /// Frequency in Hz, decay in 1/s and gain of each of three modes.
+    const TRUTH: [(f64, f64, f64); 3] = [
+        (1000.0, 300.0, 0.5),
+        (1040.0, 3.0, -0.1),
+        (1085.0, 40.0, 0.2),
+    ];
+
+    /// `len` samples at `rate` of [`TRUTH`] struck `delay_s` after the first, plus `noise`.
+    fn strike(rate: f64, len: usize, delay_s: f64, mut noise: impl FnMut() -> f64) -> Vec<f64> {
+        (0..len)
+            .map(|n| {
+                let t = n as f64 / rate - delay_s;
+                TRUTH
+                    .iter()
+                    .map(|&(f, d, g)| g * (-d * t).exp() * (TAU * f * t).sin())
+                    .sum::<f64>()
+                    + noise()
+            })
+            .collect()
+    }
+
+    /// The mode of `band` at `freq_hz` decaying at `decay_per_s`, with `gain`.
+    fn mode(band: &Band, freq_hz: f64, decay_per_s: f64, gain: f64) -> Exp {
+        Exp {
+            s: Complex64::new(
+                -decay_per_s * band.dt_s,
+                TAU * (freq_hz - band.base_hz) * band.dt_s,
+            ),
+            gain,
+        }
+    }
+
     /// The model is the band of the modes exactly, from the onset to past the end of a sound
     /// cut while it rings, in a band taken from a shortened transform too.
     #[test]
     fn the_model_is_the_band_of_its_modes() {
         let rate = 44_100.0;
-        let truth = [
-            (1000.0, 300.0, 0.5),
-            (1040.0, 3.0, -0.1),
-            (1085.0, 40.0, 0.2),
-        ];
         let delay = 0.3 / rate;
-        let x: Vec<f64> = (0..30_000)
-            .map(|n| {
-                let t = n as f64 / rate - delay;
-                truth
-                    .iter()
-                    .map(|&(f, d, g)| g * (-d * t).exp() * (TAU * f * t).sin())
-                    .sum::<f64>()
-            })
-            .collect();
+        let x = strike(rate, 30_000, delay, || 0.0);
         let mut splitter = Splitter::new(&x, rate);
         for samples in [usize::MAX, 300] {
             let band = splitter.band((1008.0, 1129.0), samples);
             let target = Target::new(&band, 0..band.samples.len(), 1e-12, 8);
             let fit = Modes {
-                modes: truth
+                modes: TRUTH
                     .iter()
-                    .map(|&(f, d, g)| Exp {
-                        s: Complex64::new(-d * band.dt_s, TAU * (f - band.base_hz) * band.dt_s),
-                        gain: g,
-                    })
+                    .map(|&(f, d, g)| mode(&band, f, d, g))
                     .collect(),
                 tau: delay / band.dt_s,
             };
@@ -572,36 +588,18 @@ mod tests {
     #[test]
     fn refinement_recovers_exact_modes_and_selection_drops_a_spurious_one() {
         let rate = 48_000.0;
-        // Frequency in Hz, decay in 1/s, gain.
-        let truth = [
-            (1000.0, 300.0, 0.5),
-            (1040.0, 3.0, -0.1),
-            (1085.0, 40.0, 0.2),
-        ];
         let delay = 0.4 / rate;
         let mut rng = Rng::new(11);
-        let x: Vec<f64> = (0..24_000)
-            .map(|n| {
-                let t = n as f64 / rate - delay;
-                truth
-                    .iter()
-                    .map(|&(f, d, g)| g * (-d * t).exp() * (TAU * f * t).sin())
-                    .sum::<f64>()
-                    + 1e-5 * rng.bipolar() as f64
-            })
-            .collect();
+        let x = strike(rate, 24_000, delay, || 1e-5 * rng.bipolar() as f64);
         let bands = split(&x, rate, &layout(900.0, 1200.0));
         let band = bands
             .iter()
             .find(|b| (b.core_hz.0..b.core_hz.1).contains(&1040.0))
             .unwrap();
         let target = Target::new(band, 0..band.samples.len(), 1e-10, 8);
-        let guess = |f: f64, d: f64| Exp {
-            s: Complex64::new(-d * band.dt_s, TAU * (f - band.base_hz) * band.dt_s),
-            gain: 0.0,
-        };
+        let guess = |f: f64, d: f64| mode(band, f, d, 0.0);
         let mut start = Modes {
-            modes: truth
+            modes: TRUTH
                 .iter()
                 .map(|&(f, d, _)| guess(f + 0.1, d * 1.1))
                 .collect(),
@@ -612,7 +610,7 @@ mod tests {
         target.gains(&mut start);
         let (kept, _) = target.select(start);
         assert_eq!(kept.modes.len(), 3, "{kept:?}");
-        for &(f, d, g) in &truth {
+        for &(f, d, g) in &TRUTH {
             let got = kept
                 .modes
                 .iter()
