@@ -3,11 +3,12 @@
 //! One recording per strike position. For each: find the onset ([`onset`]), split the sound
 //! into frequency bands ([`subband`]), find each band's modes by ESPRIT ([`esprit`]) and refine
 //! them, with the time of the strike, against the band's signal, keeping those that shorten its
-//! description ([`refine`], [`bandfit`]); leave out hum ([`analyse`]). Then match modes across
-//! recordings and measure every mode's gain in every recording ([`combine`]), and score each
-//! recording against the bank re-synthesised through the engine at its position
-//! ([`fidelity`]). The noise spectrum ([`noise`]) and the per-mode tracks ([`track`]) feed the
-//! report.
+//! description ([`refine`], [`bandfit`]); leave out hum ([`analyse`]); then match each mode's
+//! level over time to the recording's, in dB, and give the partials still missing a mode
+//! ([`levels`]). Then match modes across recordings and measure every mode's gain in every
+//! recording ([`combine`]), and score each recording against the bank re-synthesised through the
+//! engine at its position ([`fidelity`]). The noise spectrum ([`noise`]) and the per-mode tracks
+//! ([`track`]) feed the report.
 //!
 //! Gains are in the bank format's units: the amplitude, in full scale of the recording, of the
 //! mode at the strike, `y_k(t) = sum_n a_nk exp(-d_n t) sin(2 pi f_n t)`. The engine normalises a
@@ -20,6 +21,7 @@ mod combine;
 mod error;
 mod esprit;
 mod fidelity;
+mod levels;
 mod linalg;
 mod lsq;
 mod noise;

@@ -6,6 +6,7 @@
 use realfft::num_complex::Complex64;
 
 use super::bandfit::{dedupe, fit_band, BandMode};
+use super::levels::match_levels;
 use super::lsq::{add_modes, fit_amplitudes, Shape};
 use super::noise::NoiseSpectrum;
 use super::onset::{find_strike, Strike};
@@ -155,6 +156,12 @@ pub fn analyse(
     let max_hz = options.max_hz(recording.sample_rate_hz);
     find_modes(&mut analysis, options.min_hz, max_hz, progress);
     drop_steady_tones(&mut analysis);
+    match_levels(&mut analysis, options.min_hz, max_hz);
+    // Matching levels can leave a mode far under the others.
+    let sound_s = analysis.signal.len() as f64 / analysis.sample_rate_hz;
+    drop_inaudible(&mut analysis.modes, sound_s, |m| {
+        (m.amplitude, m.decay_per_s)
+    });
     Ok(analysis)
 }
 
@@ -236,7 +243,9 @@ fn find_modes(a: &mut Analysis, min_hz: f64, max_hz: f64, progress: &mut dyn FnM
     dedupe(&mut found, a.signal.len() as f64 / a.sample_rate_hz);
     // A band's reach beyond its core stops at the range searched.
     found.retain(|m| (min_hz..=max_hz).contains(&m.freq_hz));
-    drop_inaudible(&mut found, a.signal.len() as f64 / a.sample_rate_hz);
+    drop_inaudible(&mut found, a.signal.len() as f64 / a.sample_rate_hz, |m| {
+        (m.amplitude, m.decay_per_s)
+    });
     let shapes: Vec<Shape> = found
         .iter()
         .map(|m| Shape {
@@ -259,14 +268,16 @@ fn find_modes(a: &mut Analysis, min_hz: f64, max_hz: f64, progress: &mut dyn FnM
 }
 
 /// Leaves out modes whose energy over the sound is more than [`INAUDIBLE_DB`] below the
-/// strongest mode's: a rounding error of the fit, never heard beside it.
-fn drop_inaudible(modes: &mut Vec<BandMode>, sound_s: f64) {
+/// strongest mode's: a rounding error of the fit, never heard beside it. `shape` gives a mode's
+/// complex amplitude and decay.
+fn drop_inaudible<T>(modes: &mut Vec<T>, sound_s: f64, shape: impl Fn(&T) -> (Complex64, f64)) {
     // The energy of a |a| exp(-d t) envelope over the sound: |a|^2 (1 - exp(-2 d T)) / (2 d).
-    let energy = |m: &BandMode| {
-        let d = m.decay_per_s.max(1e-9);
-        m.amplitude.norm_sqr() * -(-2.0 * d * sound_s).exp_m1() / (2.0 * d)
+    let energy = |m: &T| {
+        let (amplitude, decay) = shape(m);
+        let d = decay.max(1e-9);
+        amplitude.norm_sqr() * -(-2.0 * d * sound_s).exp_m1() / (2.0 * d)
     };
-    let loudest = modes.iter().map(energy).fold(0.0, f64::max);
+    let loudest = modes.iter().map(&energy).fold(0.0, f64::max);
     let floor = loudest * 10f64.powf(-INAUDIBLE_DB / 10.0);
     modes.retain(|m| energy(m) >= floor);
 }

@@ -36,7 +36,7 @@ const FRAMES_PER_WINDOW: usize = 4;
 const PASSES: usize = 3;
 
 /// A mode followed through the frames.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Track {
     /// Frequency in Hz.
     pub freq_hz: f64,
