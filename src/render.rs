@@ -14,7 +14,7 @@ use std::sync::Arc;
 
 pub use midi_file::read_midi_file;
 pub use notes::{parse_notes, Note};
-pub use wav::{to_int_sample, write_wav, BitDepth};
+pub use wav::{to_int_sample, wav_bytes, write_wav, BitDepth};
 
 use crate::dsp::coeffs::{db_to_gain, gain_to_db};
 use crate::engine::{Controls, Engine, NoteEvent, PreparedBank};

@@ -998,3 +998,205 @@ fn compress_merges_and_drops_and_reports() {
     );
     assert!(!dir.path().join("x.json").exists());
 }
+
+/// The notes of the output-path tests: one short strike.
+const ONE_NOTE: &str = "69:0.8@0+0.1";
+
+#[cfg(unix)]
+#[test]
+fn outputs_follow_links_keep_permissions_and_refuse_what_is_no_file() {
+    use std::os::unix::fs::{MetadataExt, PermissionsExt};
+    let dir = dir_with_bank();
+    let d = dir.path();
+    let render_to = |output: &str| {
+        run(
+            d,
+            &["render", "bank.json", "--notes", ONE_NOTE, "-o", output],
+        )
+    };
+    let is_wav = |path: &Path| std::fs::read(path).unwrap().starts_with(b"RIFF");
+
+    // A symbolic link is followed: its target gets the WAV, the link stays a link.
+    std::fs::write(d.join("target.wav"), b"old").unwrap();
+    std::os::unix::fs::symlink("target.wav", d.join("link.wav")).unwrap();
+    let out = render_to("link.wav");
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(std::fs::symlink_metadata(d.join("link.wav"))
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    assert!(is_wav(&d.join("target.wav")));
+
+    // A dangling link makes the file it names.
+    std::os::unix::fs::symlink("new.wav", d.join("dangling.wav")).unwrap();
+    let out = render_to("dangling.wav");
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(is_wav(&d.join("new.wav")));
+
+    // An existing file keeps its permissions.
+    std::fs::write(d.join("private.wav"), b"old").unwrap();
+    std::fs::set_permissions(
+        d.join("private.wav"),
+        std::fs::Permissions::from_mode(0o600),
+    )
+    .unwrap();
+    let out = render_to("private.wav");
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(is_wav(&d.join("private.wav")));
+    let mode = std::fs::metadata(d.join("private.wav")).unwrap().mode() & 0o777;
+    assert_eq!(mode, 0o600);
+
+    // A named pipe, a device and a directory are refused, named, and left as they were.
+    let fifo = d.join("pipe.wav");
+    let c_path = std::ffi::CString::new(fifo.as_os_str().as_encoded_bytes()).unwrap();
+    // SAFETY: a valid NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c_path.as_ptr(), 0o644) }, 0);
+    std::fs::create_dir(d.join("folder")).unwrap();
+    for (output, kind) in [
+        ("pipe.wav", "named pipe"),
+        ("/dev/null", "device"),
+        ("folder", "directory"),
+    ] {
+        let out = render_to(output);
+        assert!(!out.status.success(), "{output} was written");
+        let err = stderr(&out);
+        assert!(
+            err.contains(output) && err.contains(kind) && err.contains("not a regular file"),
+            "{output}: {err}"
+        );
+    }
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo_like());
+    // Nothing else was left behind.
+    let mut names = entries(d);
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "bank.json",
+            "dangling.wav",
+            "folder",
+            "link.wav",
+            "new.wav",
+            "pipe.wav",
+            "private.wav",
+            "target.wav"
+        ]
+    );
+}
+
+/// Whether a file type is a named pipe (a shorthand for the test above).
+#[cfg(unix)]
+trait FifoLike {
+    fn is_fifo_like(&self) -> bool;
+}
+
+#[cfg(unix)]
+impl FifoLike for std::fs::FileType {
+    fn is_fifo_like(&self) -> bool {
+        std::os::unix::fs::FileTypeExt::is_fifo(self)
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn an_input_is_known_by_its_identity_not_its_name() {
+    let dir = dir_with_bank();
+    let d = dir.path();
+    std::fs::hard_link(d.join("bank.json"), d.join("alias.wav")).unwrap();
+    std::os::unix::fs::symlink("bank.json", d.join("link.wav")).unwrap();
+    let before = std::fs::read(d.join("bank.json")).unwrap();
+    for output in ["alias.wav", "link.wav"] {
+        let out = run(
+            d,
+            &["render", "bank.json", "--notes", ONE_NOTE, "-o", output],
+        );
+        assert!(!out.status.success(), "{output} overwrote the bank");
+        assert!(
+            stderr(&out).contains("would overwrite an input"),
+            "{output}: {}",
+            stderr(&out)
+        );
+        let out = run(d, &["compress", "bank.json", "-o", output]);
+        assert!(!out.status.success(), "{output} overwrote the bank");
+        assert!(
+            stderr(&out).contains("would overwrite the input"),
+            "{output}: {}",
+            stderr(&out)
+        );
+    }
+    assert_eq!(std::fs::read(d.join("bank.json")).unwrap(), before);
+}
+
+#[test]
+fn a_render_to_dash_goes_to_standard_output() {
+    let dir = dir_with_bank();
+    let d = dir.path();
+    let out = run(d, &["render", "bank.json", "--notes", ONE_NOTE, "-o", "-"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(entries(d), ["bank.json"], "a file was written");
+    let reader = hound::WavReader::new(std::io::Cursor::new(out.stdout.clone())).unwrap();
+    assert_eq!(reader.spec().channels, 2);
+    assert!(reader.len() > 0);
+    // The summary goes to standard error, out of the WAV's way.
+    assert!(stderr(&out).contains("standard output"), "{}", stderr(&out));
+    // The same render to a file holds the same bytes.
+    let file = run(
+        d,
+        &["render", "bank.json", "--notes", ONE_NOTE, "-o", "x.wav"],
+    );
+    assert!(file.status.success());
+    let again = run(d, &["render", "bank.json", "--notes", ONE_NOTE, "-o", "-"]);
+    assert_eq!(std::fs::read(d.join("x.wav")).unwrap(), again.stdout);
+}
+
+#[cfg(unix)]
+#[test]
+fn listing_commands_end_quietly_when_their_pipe_closes() {
+    use std::io::Read;
+    use std::process::Stdio;
+    let dir = tempfile::tempdir().unwrap();
+    for args in [
+        &["schema"][..],
+        &["info", "ideal-string"],
+        &["list"],
+        &["validate", "ideal-string"],
+    ] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_modal-resonator"))
+            .current_dir(dir.path())
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // Close the pipe before reading anything, as `| true` does: the first line printed
+        // meets a closed pipe.
+        drop(child.stdout.take());
+        let mut err = String::new();
+        child
+            .stderr
+            .take()
+            .unwrap()
+            .read_to_string(&mut err)
+            .unwrap();
+        child.wait().unwrap();
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert!(err.is_empty(), "{args:?}: {err}");
+    }
+}
+
+#[test]
+fn validate_takes_factory_preset_names() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = run(dir.path(), &["validate", "ideal-string"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("ok (factory preset"),
+        "{}",
+        stdout(&out)
+    );
+    let out = run(dir.path(), &["validate", "no-such-bank"]);
+    assert!(!out.status.success());
+}

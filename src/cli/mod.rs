@@ -18,6 +18,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use modal_resonator::model::factory::{factory_bank, factory_banks, factory_slug};
+use modal_resonator::model::staged::destination;
 use modal_resonator::model::{load_bank_file, Bank};
 
 /// Modal Resonator: modal-synthesis instrument and bank tool.
@@ -81,6 +82,10 @@ pub fn main() -> ExitCode {
     } else {
         Cli::parse()
     };
+    let standalone = matches!(cli.command, Some(Command::Play { .. }) | None);
+    if !standalone {
+        quiet_on_closed_pipe();
+    }
     let result = match cli.command {
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Fit(args)) => fit::run(&args),
@@ -102,6 +107,17 @@ pub fn main() -> ExitCode {
     }
 }
 
+/// Lets a closed output pipe end the process silently, as it ends `cat` (`info | head`),
+/// instead of making every later print fail. Not for the standalone, whose audio and MIDI
+/// connections must see a closed socket as an error.
+fn quiet_on_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: restoring the default disposition of SIGPIPE, before any other thread runs.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 /// Loads the bank named on the command line: a bank file (validated) if `arg` is a path that
 /// exists, else the factory bank of that name or slug.
 pub(super) fn load_bank(arg: &str) -> Result<Bank, String> {
@@ -118,13 +134,21 @@ pub(super) fn load_bank(arg: &str) -> Result<Bank, String> {
     })
 }
 
-/// Fails early, before a long render, when the output is a directory or its directory does not
-/// exist.
+/// The output path that means standard output.
+pub(super) const STDOUT: &str = "-";
+
+/// Fails early, before a long render, when the output cannot be written: something other than
+/// a regular file is there (a directory, a device, a named pipe, a socket; a symbolic link is
+/// followed), or its directory does not exist.
 pub(super) fn check_output_dir(output: &Path) -> Result<(), String> {
-    if output.is_dir() {
-        return Err(format!("{}: is a directory", output.display()));
-    }
-    match output.parent() {
+    let target = destination(output).map_err(|e| {
+        format!(
+            "{}: {e}; name a file to write{}",
+            output.display(),
+            if output.is_dir() { " in it" } else { "" }
+        )
+    })?;
+    match target.path.parent() {
         Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => Err(format!(
             "{}: directory {} does not exist",
             output.display(),
@@ -135,9 +159,19 @@ pub(super) fn check_output_dir(output: &Path) -> Result<(), String> {
 }
 
 /// Whether `a` and `b` name the same file, whether it exists yet or is still to be written
-/// (`out.json` and `./out.json` are the same).
+/// (`out.json` and `./out.json` are the same): an existing file by its identity (device and
+/// inode, so a hard or symbolic link to it is the same file), one still to be written by where
+/// its path leads.
 pub(super) fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    if let (Ok(x), Ok(y)) = (std::fs::metadata(a), std::fs::metadata(b)) {
+        use std::os::unix::fs::MetadataExt;
+        return (x.dev(), x.ino()) == (y.dev(), y.ino());
+    }
     let resolve = |p: &Path| -> Option<std::path::PathBuf> {
+        let p = destination(p)
+            .map(|d| d.path)
+            .unwrap_or_else(|_| p.to_path_buf());
         if let Ok(path) = p.canonicalize() {
             return Some(path);
         }

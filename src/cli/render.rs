@@ -1,5 +1,6 @@
 //! `modal-resonator render`: notes or a MIDI file through a bank to a WAV file.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -7,11 +8,11 @@ use clap::Args;
 
 use modal_resonator::engine::{Controls, PreparedBank};
 use modal_resonator::render::{
-    parse_notes, read_midi_file, render, write_wav, BitDepth, Note, RenderSettings,
+    parse_notes, read_midi_file, render, wav_bytes, write_wav, BitDepth, Note, RenderSettings,
 };
 
 use super::progress::Progress;
-use super::{check_output_dir, load_bank, same_file};
+use super::{check_output_dir, load_bank, same_file, STDOUT};
 
 /// Arguments of `render`.
 #[derive(Debug, Args)]
@@ -25,7 +26,8 @@ pub(super) struct RenderArgs {
     /// Standard MIDI file to play (all tracks and channels).
     #[arg(long, value_name = "FILE")]
     midi: Option<PathBuf>,
-    /// WAV file to write.
+    /// WAV file to write (a symbolic link's target is replaced, an existing file keeps its
+    /// permissions); `-` writes the WAV to standard output.
     #[arg(short, long, value_name = "FILE")]
     output: PathBuf,
     /// Set a control on top of the bank's defaults, e.g. --set material=wood; repeatable.
@@ -64,10 +66,13 @@ pub(super) fn run(args: &RenderArgs) -> Result<(), String> {
             args.max_seconds
         ));
     }
-    check_output_dir(&args.output)?;
+    let to_stdout = args.output.as_os_str() == STDOUT;
+    if !to_stdout {
+        check_output_dir(&args.output)?;
+    }
     let inputs = [Some(Path::new(&args.bank)), args.midi.as_deref()];
     for input in inputs.into_iter().flatten() {
-        if same_file(input, &args.output) {
+        if !to_stdout && same_file(input, &args.output) {
             return Err(format!(
                 "{}: the output would overwrite an input",
                 args.output.display()
@@ -86,13 +91,27 @@ pub(super) fn run(args: &RenderArgs) -> Result<(), String> {
     let bank = Arc::new(PreparedBank::new(&bank));
     let rendered = render(&bank, &notes, &settings, |done| progress.set(done));
     let elapsed = progress.finish();
-    write_wav(&args.output, &rendered, args.bits, args.rate).map_err(|e| e.to_string())?;
+    if to_stdout {
+        let bytes = wav_bytes(&rendered, args.bits, args.rate)
+            .map_err(|e| format!("standard output: cannot write WAV: {e}"))?;
+        let mut out = std::io::stdout().lock();
+        out.write_all(&bytes)
+            .and_then(|()| out.flush())
+            .map_err(|e| format!("standard output: {e}"))?;
+    } else {
+        write_wav(&args.output, &rendered, args.bits, args.rate).map_err(|e| e.to_string())?;
+    }
 
     let peak_dbfs = rendered.peak_dbfs();
     let clipped = args.bits != BitDepth::Float32 && rendered.peak() > 1.0;
-    println!(
+    // With the WAV on standard output, the summary goes to standard error.
+    let summary = format!(
         "{}: {:.2} s, {} Hz {}, peak {:.1} dBFS{}, up to {} voices, rendered in {:.2} s{}",
-        args.output.display(),
+        if to_stdout {
+            "standard output".into()
+        } else {
+            args.output.display().to_string()
+        },
         rendered.duration_s(),
         args.rate,
         args.bits.name(),
@@ -106,6 +125,11 @@ pub(super) fn run(args: &RenderArgs) -> Result<(), String> {
             ""
         },
     );
+    if to_stdout {
+        eprintln!("{summary}");
+    } else {
+        println!("{summary}");
+    }
     Ok(())
 }
 

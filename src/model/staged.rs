@@ -1,6 +1,10 @@
 //! Files written in two steps: the whole content to a temporary file beside the destination,
 //! then a rename over it. A command writing several files stages them all before committing
 //! any, so a failure leaves every destination as it was.
+//!
+//! The destination is where the path leads ([`destination`]): a symbolic link is followed and
+//! its target replaced (the link stays a link), an existing file keeps its permissions, and
+//! anything but a regular file (a directory, a device, a named pipe, a socket) is refused.
 
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
@@ -21,23 +25,13 @@ pub struct StagedFile {
 impl StagedFile {
     /// Writes `content` to a temporary file named `.{prefix}-*.tmp` beside `path`.
     pub fn write(path: &Path, prefix: &str, content: &[u8]) -> io::Result<Self> {
-        let dir = match path.parent() {
-            Some(dir) if !dir.as_os_str().is_empty() => dir,
-            _ => Path::new("."),
-        };
-        let mut builder = tempfile::Builder::new();
-        let prefix = format!(".{prefix}-");
-        builder.prefix(&prefix).suffix(".tmp");
-        // A file the user asked for: the usual permissions less the umask, not a private
-        // temporary's owner-only ones.
-        #[cfg(unix)]
-        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-        let mut temp = builder.tempfile_in(dir)?;
+        let destination = destination(path)?;
+        let mut temp = temp_beside(&destination, &format!(".{prefix}-"), ".tmp")?;
         temp.write_all(content)?;
         temp.as_file().sync_all()?;
         Ok(Self {
             temp,
-            path: path.to_path_buf(),
+            path: destination.path,
         })
     }
 
@@ -53,6 +47,106 @@ impl StagedFile {
             .map(|_| ())
             .map_err(|e| e.error)
     }
+}
+
+/// Where a file written to a path lands.
+#[derive(Debug, Clone)]
+pub struct Destination {
+    /// The path itself, or the file a symbolic link there leads to.
+    pub path: PathBuf,
+    /// The permissions of the regular file there now, kept by the new one; `None` when there is
+    /// no file yet.
+    pub permissions: Option<std::fs::Permissions>,
+}
+
+/// Most symbolic links followed in a row, as the kernel's `ELOOP` limit.
+const MAX_LINKS: usize = 40;
+
+/// Where writing to `path` lands: symbolic links followed (a dangling one to the file it names),
+/// and what is there now, which must be a regular file or nothing. The error for anything else
+/// says what it is.
+pub fn destination(path: &Path) -> io::Result<Destination> {
+    let mut path = path.to_path_buf();
+    for _ in 0..MAX_LINKS {
+        let meta = match std::fs::symlink_metadata(&path) {
+            Ok(meta) => meta,
+            Err(e) if e.kind() == io::ErrorKind::NotFound => {
+                return Ok(Destination {
+                    path,
+                    permissions: None,
+                })
+            }
+            Err(e) => return Err(e),
+        };
+        let kind = meta.file_type();
+        if kind.is_symlink() {
+            let target = std::fs::read_link(&path)?;
+            path = match path.parent() {
+                Some(dir) if target.is_relative() => dir.join(target),
+                _ => target,
+            };
+            continue;
+        }
+        if kind.is_file() {
+            return Ok(Destination {
+                path,
+                permissions: Some(meta.permissions()),
+            });
+        }
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!("is {}, not a regular file", kind_name(&kind)),
+        ));
+    }
+    Err(io::Error::new(
+        io::ErrorKind::InvalidInput,
+        format!("more than {MAX_LINKS} symbolic links in a row"),
+    ))
+}
+
+/// What a file that is not a regular file is, with its article.
+fn kind_name(kind: &std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_char_device() || kind.is_block_device() {
+            return "a device";
+        }
+        if kind.is_fifo() {
+            return "a named pipe";
+        }
+        if kind.is_socket() {
+            return "a socket";
+        }
+    }
+    if kind.is_dir() {
+        "a directory"
+    } else {
+        "something else"
+    }
+}
+
+/// An empty temporary file beside `destination`, named `{prefix}*{suffix}`, with the
+/// permissions the destination has, or a new file's (the usual ones less the umask, not a
+/// private temporary's owner-only ones). Dropped, it is removed.
+pub fn temp_beside(
+    destination: &Destination,
+    prefix: &str,
+    suffix: &str,
+) -> io::Result<NamedTempFile> {
+    let dir = match destination.path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    };
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(prefix).suffix(suffix);
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let temp = builder.tempfile_in(dir)?;
+    if let Some(permissions) = &destination.permissions {
+        temp.as_file().set_permissions(permissions.clone())?;
+    }
+    Ok(temp)
 }
 
 /// A destination replaced by [`commit_all`], and what it held before.
@@ -134,14 +228,19 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let (kept, new) = (dir.path().join("kept.txt"), dir.path().join("new.txt"));
         std::fs::write(&kept, "old").unwrap();
-        // A destination that is a directory cannot be replaced by a file.
+        // A destination that became a directory after it was staged cannot be replaced by a
+        // file (one that is a directory already is refused when staged).
         let blocked = dir.path().join("blocked");
-        std::fs::create_dir(&blocked).unwrap();
         let files = vec![
             StagedFile::write(&kept, "test", b"new").unwrap(),
             StagedFile::write(&new, "test", b"new").unwrap(),
             StagedFile::write(&blocked, "test", b"new").unwrap(),
         ];
+        std::fs::create_dir(&blocked).unwrap();
+        assert!(StagedFile::write(&blocked, "test", b"new")
+            .unwrap_err()
+            .to_string()
+            .contains("is a directory"));
         let (failed, _) = commit_all(files).unwrap_err();
         assert_eq!(failed, blocked);
         assert_eq!(std::fs::read_to_string(&kept).unwrap(), "old");

@@ -1,16 +1,12 @@
 //! Stereo WAV files, written atomically.
 
-use std::fs::File;
-use std::io::BufWriter;
+use std::io::{BufWriter, Seek, Write};
 use std::path::Path;
 
 use hound::{SampleFormat, WavSpec, WavWriter};
 
 use super::{RenderError, Rendered};
-
-/// Permission bits of a new WAV file before the umask, as for any file a program creates.
-#[cfg(unix)]
-const NEW_FILE_MODE: u32 = 0o666;
+use crate::model::staged::{destination, temp_beside};
 
 /// Sample format of a WAV file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -70,7 +66,9 @@ pub fn to_int_sample(x: f32, bits: u16) -> i32 {
 ///
 /// Atomic: the file is written to a temporary file in the destination directory and renamed into
 /// place, so on any failure neither a partial file nor the temporary file is left behind, and an
-/// existing file at `path` is untouched.
+/// existing file at `path` is untouched. The destination is where `path` leads
+/// ([`destination`]): a symbolic link's target is replaced, an existing file keeps its
+/// permissions, and a directory, device, named pipe or socket is refused.
 pub fn write_wav(
     path: impl AsRef<Path>,
     rendered: &Rendered,
@@ -86,18 +84,41 @@ pub fn write_wav(
         path: path.to_path_buf(),
         source,
     };
-    let dir = match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".modal-resonator-").suffix(".wav.tmp");
-    // The file a user asked for, not a private temporary: the usual permissions less the umask.
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(NEW_FILE_MODE));
+    let destination = destination(path).map_err(io_error)?;
     // Dropping `temp` on any early return deletes it.
-    let mut temp = builder.tempfile_in(dir).map_err(io_error)?;
+    let mut temp = temp_beside(&destination, ".modal-resonator-", ".wav.tmp").map_err(io_error)?;
+    encode(
+        BufWriter::new(temp.as_file_mut()),
+        rendered,
+        bit_depth,
+        sample_rate_hz,
+    )
+    .map_err(wav_error)?;
+    temp.as_file().sync_all().map_err(io_error)?;
+    temp.persist(&destination.path)
+        .map_err(|e| io_error(e.error))?;
+    Ok(())
+}
 
+/// `rendered` as the bytes of a WAV file, as [`write_wav`] writes it: for a stream (standard
+/// output) that cannot seek back to fill in the header.
+pub fn wav_bytes(
+    rendered: &Rendered,
+    bit_depth: BitDepth,
+    sample_rate_hz: u32,
+) -> hound::Result<Vec<u8>> {
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    encode(&mut bytes, rendered, bit_depth, sample_rate_hz)?;
+    Ok(bytes.into_inner())
+}
+
+/// Encodes `rendered` as a stereo WAV file into `out`.
+fn encode<W: Write + Seek>(
+    out: W,
+    rendered: &Rendered,
+    bit_depth: BitDepth,
+    sample_rate_hz: u32,
+) -> hound::Result<()> {
     let spec = WavSpec {
         channels: 2,
         sample_rate: sample_rate_hz,
@@ -107,16 +128,13 @@ pub fn write_wav(
             _ => SampleFormat::Int,
         },
     };
-    let mut writer = WavWriter::new(BufWriter::new(temp.as_file_mut()), spec).map_err(wav_error)?;
-    write_samples(&mut writer, rendered, bit_depth).map_err(wav_error)?;
-    writer.finalize().map_err(wav_error)?;
-    temp.as_file().sync_all().map_err(io_error)?;
-    temp.persist(path).map_err(|e| io_error(e.error))?;
-    Ok(())
+    let mut writer = WavWriter::new(out, spec)?;
+    write_samples(&mut writer, rendered, bit_depth)?;
+    writer.finalize()
 }
 
-fn write_samples(
-    writer: &mut WavWriter<BufWriter<&mut File>>,
+fn write_samples<W: Write + Seek>(
+    writer: &mut WavWriter<W>,
     rendered: &Rendered,
     bit_depth: BitDepth,
 ) -> hound::Result<()> {
