@@ -258,7 +258,7 @@ fn add_missing(
         // The peak between bins, from a parabola through the log powers.
         let (l, c, r) = (rec[k - 1].ln(), rec[k].ln(), rec[k + 1].ln());
         let denom = l - 2.0 * c + r;
-        let offset = if denom < 0.0 {
+        let offset = if denom < 0.0 && denom.is_finite() {
             (0.5 * (l - r) / denom).clamp(-0.5, 0.5)
         } else {
             0.0
@@ -294,7 +294,10 @@ fn add_missing(
         if unit_power.is_nan() || unit_power <= 0.0 {
             continue;
         }
-        let amplitude = (10f64.powf(at_onset_db / 10.0) / unit_power).sqrt();
+        // Both at the first frame: the unit mode's power there is that of the frame, not of
+        // its onset.
+        let first_frame_db = at_onset_db + slope_db_per_s * frame_s[0];
+        let amplitude = (10f64.powf(first_frame_db / 10.0) / unit_power).sqrt();
         added.push(super::analyse::Found {
             amplitude: Complex64::new(0.0, -amplitude),
             gain: amplitude,
