@@ -1065,10 +1065,9 @@ fn outputs_follow_links_keep_permissions_and_refuse_what_is_no_file() {
             "{output}: {err}"
         );
     }
-    assert!(std::fs::symlink_metadata(&fifo)
-        .unwrap()
-        .file_type()
-        .is_fifo_like());
+    assert!(std::os::unix::fs::FileTypeExt::is_fifo(
+        &std::fs::symlink_metadata(&fifo).unwrap().file_type()
+    ));
     // Nothing else was left behind.
     let mut names = entries(d);
     names.sort();
@@ -1085,19 +1084,6 @@ fn outputs_follow_links_keep_permissions_and_refuse_what_is_no_file() {
             "target.wav"
         ]
     );
-}
-
-/// Whether a file type is a named pipe (a shorthand for the test above).
-#[cfg(unix)]
-trait FifoLike {
-    fn is_fifo_like(&self) -> bool;
-}
-
-#[cfg(unix)]
-impl FifoLike for std::fs::FileType {
-    fn is_fifo_like(&self) -> bool {
-        std::os::unix::fs::FileTypeExt::is_fifo(self)
-    }
 }
 
 #[cfg(unix)]
