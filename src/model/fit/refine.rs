@@ -24,6 +24,7 @@
 //! unweighted fit follows the loud start and lets the tail go (a fast-then-slow decay would keep
 //! only its fast part).
 
+use std::cell::RefCell;
 use std::f64::consts::TAU;
 use std::sync::Arc;
 
@@ -95,8 +96,6 @@ struct Column {
     /// Derivatives by the pole's log-magnitude and angle, for the mode's gain.
     d_log_magnitude: Vec<Complex64>,
     d_angle: Vec<Complex64>,
-    /// Derivative of the whole band by the strike time, for this mode's gain.
-    d_tau_bins: Vec<Complex64>,
 }
 
 /// The samples of a band fitted, with their weights.
@@ -111,6 +110,10 @@ pub struct Target<'a> {
     inverse: Arc<dyn Fft<f64>>,
     /// Per bin of the band: `w^k` and `w^(k L)`.
     twiddles: Vec<(Complex64, Complex64)>,
+    /// Scratch space of `inverse`.
+    scratch: RefCell<Vec<Complex64>>,
+    /// Work buffers as long as the band's transform.
+    work: RefCell<[Vec<Complex64>; 4]>,
 }
 
 impl<'a> Target<'a> {
@@ -148,11 +151,17 @@ impl<'a> Target<'a> {
                 )
             })
             .collect();
+        let inverse = FftPlanner::new().plan_fft_inverse(bins);
         Self {
             band,
             range,
             weights,
-            inverse: FftPlanner::new().plan_fft_inverse(bins),
+            scratch: RefCell::new(vec![
+                Complex64::new(0.0, 0.0);
+                inverse.get_inplace_scratch_len()
+            ]),
+            work: RefCell::default(),
+            inverse,
             twiddles,
         }
     }
@@ -184,22 +193,25 @@ impl<'a> Target<'a> {
         )
     }
 
-    /// The band's samples over `range` from bins `bins` (consumed).
-    fn back(&self, mut bins: Vec<Complex64>) -> Vec<Complex64> {
-        self.inverse.process(&mut bins);
-        bins.truncate(self.range.end);
-        bins.drain(..self.range.start);
-        bins
+    /// The band's samples over `range` from bins `bins` (transformed in place).
+    fn back(&self, bins: &mut [Complex64]) -> Vec<Complex64> {
+        let mut scratch = self.scratch.borrow_mut();
+        self.inverse.process_with_scratch(bins, &mut scratch);
+        bins[self.range.clone()].to_vec()
     }
 
-    /// The bins of a mode `m` starting at `tau`: for a gain of 1, and (with `derivatives`) by
-    /// its pole's log-magnitude and angle and by the strike time.
+    /// Adds to `unit` the bins of a mode `m` starting at `tau` for a gain of `gain`; with
+    /// `derivatives`, writes its bins by its pole's log-magnitude and angle (for a gain of 1) to
+    /// the first two and adds its bins by the strike time (for its own gain) to the third. Bins
+    /// outside the band are left alone.
     fn mode_bins(
         &self,
         m: &Exp,
         tau: f64,
-        derivatives: bool,
-    ) -> (Vec<Complex64>, Option<[Vec<Complex64>; 3]>) {
+        gain: f64,
+        unit: &mut [Complex64],
+        mut derivatives: Option<[&mut [Complex64]; 3]>,
+    ) {
         let scale = self.band.decimation();
         let len = self.band.sound_len as f64;
         let s = self.full_rate(m.s);
@@ -210,15 +222,6 @@ impl<'a> Target<'a> {
         let q = Complex64::new(0.0, -0.5) * (-s * tau_f).exp();
         let qc = Complex64::new(0.0, 0.5) * (-sc * tau_f).exp();
         let one = Complex64::new(1.0, 0.0);
-        let bins = self.twiddles.len();
-        let mut unit = vec![Complex64::new(0.0, 0.0); bins];
-        let mut d = derivatives.then(|| {
-            [
-                vec![Complex64::new(0.0, 0.0); bins],
-                vec![Complex64::new(0.0, 0.0); bins],
-                vec![Complex64::new(0.0, 0.0); bins],
-            ]
-        });
         // P(a) = (1 - a_L) / (1 - a) with a = e^s w^k, a_L = a^L; dP/ds.
         let p_and_dp = |a: Complex64, al: Complex64| {
             let inv = (one - a).inv();
@@ -231,51 +234,68 @@ impl<'a> Target<'a> {
             }
             let (p, dp) = p_and_dp(es * w, esl * wl);
             let (pc, dpc) = p_and_dp(es.conj() * w, esl.conj() * wl);
-            unit[j] = (q * p + qc * pc) * t;
-            if let Some([dm, da, dt]) = d.as_mut() {
+            unit[j] += ((q * p + qc * pc) * t) * gain;
+            if let Some([dm, da, dt]) = derivatives.as_mut() {
                 let e = q * (dp - p * tau_f);
                 let ec = qc * (dpc - pc * tau_f);
                 dm[j] = (e + ec) * (t / scale);
                 da[j] = Complex64::new(0.0, 1.0) * (e - ec) * (t / scale);
-                dt[j] = -(s * q * p + sc * qc * pc) * (t * scale);
+                dt[j] += (-(s * q * p + sc * qc * pc) * (t * scale)) * m.gain;
             }
         }
-        (unit, d)
+    }
+
+    /// A work buffer as long as the band's transform, zeroed.
+    fn zeroed(&self, buffer: &mut Vec<Complex64>) {
+        buffer.clear();
+        buffer.resize(self.twiddles.len(), Complex64::new(0.0, 0.0));
     }
 
     /// Each mode's part of the band for a gain of 1, over the samples fitted.
     fn units(&self, fit: &Modes) -> Vec<Vec<Complex64>> {
-        fit.modes
-            .iter()
-            .map(|m| self.back(self.mode_bins(m, fit.tau, false).0))
-            .collect()
-    }
-
-    /// Each mode's part of the band and its derivatives, over the samples fitted.
-    fn columns(&self, fit: &Modes) -> Vec<Column> {
+        let mut work = self.work.borrow_mut();
+        let [bins, ..] = &mut *work;
         fit.modes
             .iter()
             .map(|m| {
-                let (unit, d) = self.mode_bins(m, fit.tau, true);
-                let [dm, da, dt] = d.expect("derivatives asked for");
-                Column {
-                    unit: self.back(unit),
-                    d_log_magnitude: self.back(dm),
-                    d_angle: self.back(da),
-                    d_tau_bins: dt,
-                }
+                self.zeroed(bins);
+                self.mode_bins(m, fit.tau, 1.0, bins, None);
+                self.back(bins)
             })
             .collect()
     }
 
+    /// Each mode's part of the band and its derivatives, over the samples fitted, and the
+    /// derivative of the whole band by the strike time.
+    fn columns(&self, fit: &Modes) -> (Vec<Column>, Vec<Complex64>) {
+        let mut work = self.work.borrow_mut();
+        let [unit, dm, da, dt] = &mut *work;
+        self.zeroed(dt);
+        let columns = fit
+            .modes
+            .iter()
+            .map(|m| {
+                self.zeroed(unit);
+                self.zeroed(dm);
+                self.zeroed(da);
+                self.mode_bins(m, fit.tau, 1.0, unit, Some([&mut *dm, &mut *da, &mut *dt]));
+                Column {
+                    unit: self.back(unit),
+                    d_log_magnitude: self.back(dm),
+                    d_angle: self.back(da),
+                }
+            })
+            .collect();
+        (columns, self.back(dt))
+    }
+
     /// The model of the band over the samples fitted.
     fn model(&self, fit: &Modes) -> Vec<Complex64> {
-        let mut bins = vec![Complex64::new(0.0, 0.0); self.twiddles.len()];
+        let mut work = self.work.borrow_mut();
+        let [bins, ..] = &mut *work;
+        self.zeroed(bins);
         for m in &fit.modes {
-            let (unit, _) = self.mode_bins(m, fit.tau, false);
-            for (b, u) in bins.iter_mut().zip(unit) {
-                *b += u * m.gain;
-            }
+            self.mode_bins(m, fit.tau, m.gain, bins, None);
         }
         self.back(bins)
     }
@@ -365,14 +385,7 @@ impl<'a> Target<'a> {
     fn normal_equations(&self, fit: &Modes) -> (Vec<f64>, Vec<f64>) {
         let modes = &fit.modes;
         let dim = PARAMS * modes.len() + 1;
-        let cols = self.columns(fit);
-        let mut tau_bins = vec![Complex64::new(0.0, 0.0); self.twiddles.len()];
-        for (c, m) in cols.iter().zip(modes) {
-            for (b, v) in tau_bins.iter_mut().zip(&c.d_tau_bins) {
-                *b += v * m.gain;
-            }
-        }
-        let d_tau = self.back(tau_bins);
+        let (cols, d_tau) = self.columns(fit);
         let mut normal = vec![0.0; dim * dim];
         let mut gradient = vec![0.0; dim];
         let mut columns = vec![Complex64::new(0.0, 0.0); dim];
