@@ -320,13 +320,22 @@ impl<'a> Target<'a> {
 
     /// The weighted least-squares gains of the poles of `fit`.
     pub fn gains(&self, fit: &mut Modes) {
-        let k = fit.modes.len();
-        if k == 0 {
+        if fit.modes.is_empty() {
             return;
         }
         let units = self.units(fit);
-        let mut gram = vec![Complex64::new(0.0, 0.0); k * k];
-        let mut rhs = vec![Complex64::new(0.0, 0.0); k];
+        let all: Vec<usize> = (0..fit.modes.len()).collect();
+        let (gram, rhs) = self.gram(&units);
+        for (m, g) in fit.modes.iter_mut().zip(subset_gains(&gram, &rhs, &all)) {
+            m.gain = g;
+        }
+    }
+
+    /// `U^T W U` and `U^T W y` (real parts) of the columns `units` over the samples fitted.
+    fn gram(&self, units: &[Vec<Complex64>]) -> (Vec<f64>, Vec<f64>) {
+        let k = units.len();
+        let mut gram = vec![0.0; k * k];
+        let mut rhs = vec![0.0; k];
         for (i, (n, w)) in self.range.clone().zip(&self.weights).enumerate() {
             let w2 = w * w;
             for a in 0..k {
@@ -342,10 +351,20 @@ impl<'a> Target<'a> {
                 gram[a * k + b] = gram[b * k + a];
             }
         }
-        solve(&mut gram, &mut rhs, k, 1);
-        for (m, g) in fit.modes.iter_mut().zip(rhs) {
-            m.gain = g.re;
-        }
+        (gram, rhs)
+    }
+
+    /// Weighted squared error of the columns `units` with gains `gains`.
+    fn error_of(&self, units: &[&Vec<Complex64>], gains: &[f64]) -> f64 {
+        self.range
+            .clone()
+            .zip(&self.weights)
+            .enumerate()
+            .map(|(i, (n, w))| {
+                let model: Complex64 = units.iter().zip(gains).map(|(u, g)| u[i] * g).sum();
+                w * w * (self.band.samples[n] - model).norm_sqr()
+            })
+            .sum()
     }
 
     /// Refines every parameter of `fit` together; returns the final weighted error.
@@ -450,6 +469,10 @@ impl<'a> Target<'a> {
 
     /// Drops modes, the weakest first, while that shortens the description of the signal, then
     /// refines what is left. Returns the fit kept and its weighted error.
+    ///
+    /// The poles stay where the refinement of all the modes put them while modes are dropped,
+    /// and the gains of those left are solved again each time: the refinement runs once more,
+    /// at the end, on the modes kept.
     pub fn select(&self, mut fit: Modes) -> (Modes, f64) {
         let mut error = self.refine(&mut fit);
         while let Some(k) = self.unresolved(&fit) {
@@ -457,26 +480,41 @@ impl<'a> Target<'a> {
             self.gains(&mut fit);
             error = self.refine_for(&mut fit, SELECTION_ITERATIONS);
         }
-        loop {
-            if fit.modes.is_empty() {
-                return (fit, error);
-            }
-            let length = self.description_length(fit.modes.len(), error);
-            let energies = self.energies(&fit);
-            let weakest = (0..fit.modes.len())
-                .min_by(|&a, &b| energies[a].total_cmp(&energies[b]))
+        let units = self.units(&fit);
+        let (gram, rhs) = self.gram(&units);
+        let mut kept: Vec<usize> = (0..fit.modes.len()).collect();
+        let mut gains: Vec<f64> = fit.modes.iter().map(|m| m.gain).collect();
+        let mut length = self.description_length(kept.len(), error);
+        while !kept.is_empty() {
+            let weakest = (0..kept.len())
+                .min_by(|&a, &b| {
+                    let energy = |i: usize| gains[i] * gains[i] * gram[kept[i] * (units.len() + 1)];
+                    energy(a).total_cmp(&energy(b))
+                })
                 .expect("not empty");
-            let mut fewer = fit.clone();
-            fewer.modes.remove(weakest);
-            self.gains(&mut fewer);
-            let e = self.error(&fewer);
-            if self.description_length(fewer.modes.len(), e) >= length {
-                let error = self.refine(&mut fit);
-                return (fit, error);
+            let mut fewer = kept.clone();
+            fewer.remove(weakest);
+            let fewer_gains = subset_gains(&gram, &rhs, &fewer);
+            let columns: Vec<&Vec<Complex64>> = fewer.iter().map(|&i| &units[i]).collect();
+            let e = self.error_of(&columns, &fewer_gains);
+            let fewer_length = self.description_length(fewer.len(), e);
+            if fewer_length >= length {
+                break;
             }
-            error = self.refine_for(&mut fewer, SELECTION_ITERATIONS);
-            fit = fewer;
+            (kept, gains, length) = (fewer, fewer_gains, fewer_length);
         }
+        if kept.len() < fit.modes.len() {
+            fit.modes = kept
+                .iter()
+                .zip(&gains)
+                .map(|(&i, &gain)| Exp {
+                    gain,
+                    ..fit.modes[i]
+                })
+                .collect();
+        }
+        let error = self.refine(&mut fit);
+        (fit, error)
     }
 
     /// A mode the data cannot tell from another, if any: the weaker of two poles closer than
@@ -531,6 +569,22 @@ impl<'a> Target<'a> {
             })
             .collect()
     }
+}
+
+/// The least-squares gains of the columns `subset` of the system `gram` (`rhs` its right-hand
+/// side, both over every column).
+fn subset_gains(gram: &[f64], rhs: &[f64], subset: &[usize]) -> Vec<f64> {
+    let (k, n) = (subset.len(), rhs.len());
+    if k == 0 {
+        return Vec::new();
+    }
+    let mut a: Vec<Complex64> = subset
+        .iter()
+        .flat_map(|&i| subset.iter().map(move |&j| Complex64::new(gram[i * n + j], 0.0)))
+        .collect();
+    let mut b: Vec<Complex64> = subset.iter().map(|&i| Complex64::new(rhs[i], 0.0)).collect();
+    solve(&mut a, &mut b, k, 1);
+    b.iter().map(|g| g.re).collect()
 }
 
 #[cfg(test)]
