@@ -17,6 +17,7 @@
 
 mod analyse;
 mod bandfit;
+mod closed_form;
 mod combine;
 mod error;
 mod esprit;

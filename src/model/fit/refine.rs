@@ -31,6 +31,7 @@ use std::sync::Arc;
 use realfft::num_complex::Complex64;
 use rustfft::{Fft, FftPlanner};
 
+use super::closed_form::{self, Lanes};
 use super::linalg::solve;
 use super::subband::Band;
 
@@ -40,6 +41,9 @@ const MAX_ITERATIONS: usize = 30;
 /// Iterations of Levenberg-Marquardt after each mode the selection drops: the last fit kept is
 /// refined in full.
 const SELECTION_ITERATIONS: usize = 10;
+
+/// Iterations of Levenberg-Marquardt on all the modes, before any is dropped.
+const FIRST_ITERATIONS: usize = 10;
 
 /// Iterations stop once the error falls by less than this share.
 const TOLERANCE: f64 = 1e-7;
@@ -108,8 +112,10 @@ pub struct Target<'a> {
     weights: Vec<f64>,
     /// Inverse transform as long as the band.
     inverse: Arc<dyn Fft<f64>>,
-    /// Per bin of the band: `w^k` and `w^(k L)`.
-    twiddles: Vec<(Complex64, Complex64)>,
+    /// Bins of the band's transform.
+    bins: usize,
+    /// Per bin of the band where its taper is not zero: `w^k`, `w^(k L)` and the taper.
+    lanes: Lanes,
     /// Scratch space of `inverse`.
     scratch: RefCell<Vec<Complex64>>,
     /// Work buffers as long as the band's transform.
@@ -142,7 +148,7 @@ impl<'a> Target<'a> {
         let bins = band.taper.len();
         let n = band.fft_len as f64;
         let len = band.sound_len as f64;
-        let twiddles = (band.first_bin..band.first_bin + bins)
+        let twiddles: Vec<(Complex64, Complex64)> = (band.first_bin..band.first_bin + bins)
             .map(|k| {
                 let k = k as f64;
                 (
@@ -162,7 +168,8 @@ impl<'a> Target<'a> {
             ]),
             work: RefCell::default(),
             inverse,
-            twiddles,
+            bins,
+            lanes: Lanes::new(&twiddles, &band.taper),
         }
     }
 
@@ -210,45 +217,43 @@ impl<'a> Target<'a> {
         tau: f64,
         gain: f64,
         unit: &mut [Complex64],
-        mut derivatives: Option<[&mut [Complex64]; 3]>,
+        derivatives: Option<[&mut [Complex64]; 3]>,
     ) {
         let scale = self.band.decimation();
         let len = self.band.sound_len as f64;
         let s = self.full_rate(m.s);
-        let sc = s.conj();
         let tau_f = tau * scale;
-        let es = s.exp();
-        let esl = Complex64::from_polar((s.re * len).exp(), (s.im * len) % TAU);
-        let q = Complex64::new(0.0, -0.5) * (-s * tau_f).exp();
-        let qc = Complex64::new(0.0, 0.5) * (-sc * tau_f).exp();
-        let one = Complex64::new(1.0, 0.0);
-        // P(a) = (1 - a_L) / (1 - a) with a = e^s w^k, a_L = a^L; dP/ds.
-        let p_and_dp = |a: Complex64, al: Complex64| {
-            let inv = (one - a).inv();
-            let p = (one - al) * inv;
-            (p, (a * p - al * len) * inv)
+        let pole = closed_form::Pole {
+            es: s.exp(),
+            esl: Complex64::from_polar((s.re * len).exp(), (s.im * len) % TAU),
+            s,
+            q: Complex64::new(0.0, -0.5) * (-s * tau_f).exp(),
+            qc: Complex64::new(0.0, 0.5) * (-s.conj() * tau_f).exp(),
+            tau: tau_f,
+            len,
+            scale,
         };
-        for (j, (&(w, wl), &t)) in self.twiddles.iter().zip(&self.band.taper).enumerate() {
-            if t == 0.0 {
-                continue;
-            }
-            let (p, dp) = p_and_dp(es * w, esl * wl);
-            let (pc, dpc) = p_and_dp(es.conj() * w, esl.conj() * wl);
-            unit[j] += ((q * p + qc * pc) * t) * gain;
-            if let Some([dm, da, dt]) = derivatives.as_mut() {
-                let e = q * (dp - p * tau_f);
-                let ec = qc * (dpc - pc * tau_f);
-                dm[j] = (e + ec) * (t / scale);
-                da[j] = Complex64::new(0.0, 1.0) * (e - ec) * (t / scale);
-                dt[j] += (-(s * q * p + sc * qc * pc) * (t * scale)) * m.gain;
-            }
-        }
+        let live = self.lanes.first..self.lanes.first + self.lanes.len();
+        closed_form::mode_bins(
+            &self.lanes,
+            &pole,
+            closed_form::Out {
+                unit: &mut unit[live.clone()],
+                gain,
+                derivatives: derivatives.map(|[dm, da, dt]| {
+                    (
+                        [&mut dm[live.clone()], &mut da[live.clone()], &mut dt[live.clone()]],
+                        m.gain,
+                    )
+                }),
+            },
+        );
     }
 
     /// A work buffer as long as the band's transform, zeroed.
     fn zeroed(&self, buffer: &mut Vec<Complex64>) {
         buffer.clear();
-        buffer.resize(self.twiddles.len(), Complex64::new(0.0, 0.0));
+        buffer.resize(self.bins, Complex64::new(0.0, 0.0));
     }
 
     /// Each mode's part of the band for a gain of 1, over the samples fitted.
@@ -474,7 +479,7 @@ impl<'a> Target<'a> {
     /// and the gains of those left are solved again each time: the refinement runs once more,
     /// at the end, on the modes kept.
     pub fn select(&self, mut fit: Modes) -> (Modes, f64) {
-        let mut error = self.refine(&mut fit);
+        let mut error = self.refine_for(&mut fit, FIRST_ITERATIONS);
         while let Some(k) = self.unresolved(&fit) {
             fit.modes.remove(k);
             self.gains(&mut fit);

@@ -149,7 +149,8 @@ impl<'a> Splitter<'a> {
         let span_hz = (1.0 + 2.0 * FLAT_MARGIN * MARGIN_CORES) * (core.1 - core.0) + 2.0 * taper_hz;
         let samples = samples.min(MAX_BAND_SAMPLES) as f64;
         let wanted = (samples * self.sample_rate_hz / span_hz).ceil() as usize;
-        let fft_len = (2 * self.x.len().min(wanted)).next_power_of_two().max(64);
+        // Twice the sound: the band filter's smear of its end stays clear of its start.
+        let fft_len = 2 * fast_len(self.x.len().min(wanted)).max(32);
         let len = self.x.len().min(fft_len / 2);
         let index = match self.spectra.iter().position(|(n, _)| *n == fft_len) {
             Some(i) => i,
