@@ -32,7 +32,7 @@ use realfft::num_complex::Complex64;
 use rustfft::{Fft, FftPlanner};
 
 use super::closed_form::{self, Lanes};
-use super::linalg::solve;
+use super::linalg::{dot, solve};
 use super::subband::Band;
 
 /// Iterations of Levenberg-Marquardt.
@@ -410,33 +410,38 @@ impl<'a> Target<'a> {
         let modes = &fit.modes;
         let dim = PARAMS * modes.len() + 1;
         let (cols, d_tau) = self.columns(fit);
-        let mut normal = vec![0.0; dim * dim];
-        let mut gradient = vec![0.0; dim];
-        let mut columns = vec![Complex64::new(0.0, 0.0); dim];
+        // The weighted Jacobian by columns and the weighted residual, real parts then imaginary
+        // parts: `J^T W J` is then the real part of `J^H W J`.
+        let m = self.range.len();
+        let mut jacobian = vec![0.0; dim * 2 * m];
+        let mut residual = vec![0.0; 2 * m];
+        let mut put = |column: usize, i: usize, v: Complex64| {
+            jacobian[column * 2 * m + i] = v.re;
+            jacobian[column * 2 * m + m + i] = v.im;
+        };
         for (i, (n, &w)) in self.range.clone().zip(&self.weights).enumerate() {
             let model: Complex64 = cols
                 .iter()
                 .zip(modes)
                 .map(|(c, m)| c.unit[i] * m.gain)
                 .sum();
-            let residual = (self.band.samples[n] - model) * w;
-            for (k, (c, m)) in cols.iter().zip(modes).enumerate() {
-                columns[PARAMS * k] = c.d_log_magnitude[i] * (m.gain * w);
-                columns[PARAMS * k + 1] = c.d_angle[i] * (m.gain * w);
-                columns[PARAMS * k + 2] = c.unit[i] * w;
+            let r = (self.band.samples[n] - model) * w;
+            (residual[i], residual[m + i]) = (r.re, r.im);
+            for (k, (c, mode)) in cols.iter().zip(modes).enumerate() {
+                put(PARAMS * k, i, c.d_log_magnitude[i] * (mode.gain * w));
+                put(PARAMS * k + 1, i, c.d_angle[i] * (mode.gain * w));
+                put(PARAMS * k + 2, i, c.unit[i] * w);
             }
-            columns[dim - 1] = d_tau[i] * w;
-            for a in 0..dim {
-                let ca = columns[a].conj();
-                gradient[a] += (ca * residual).re;
-                for b in a..dim {
-                    normal[a * dim + b] += (ca * columns[b]).re;
-                }
-            }
+            put(dim - 1, i, d_tau[i] * w);
         }
+        let column = |a: usize| &jacobian[a * 2 * m..(a + 1) * 2 * m];
+        let mut normal = vec![0.0; dim * dim];
+        let mut gradient = vec![0.0; dim];
         for a in 0..dim {
-            for b in 0..a {
-                normal[a * dim + b] = normal[b * dim + a];
+            gradient[a] = dot(column(a), &residual);
+            for b in a..dim {
+                normal[a * dim + b] = dot(column(a), column(b));
+                normal[b * dim + a] = normal[a * dim + b];
             }
         }
         (normal, gradient)
