@@ -407,7 +407,7 @@ impl Engine {
     /// [`Engine::prepare`] without measuring the engine's speed.
     fn prepare_storage(&mut self, sample_rate_hz: f32) {
         assert!(
-            sample_rate_hz.is_finite() && sample_rate_hz >= 8_000.0,
+            sample_rate_hz.is_finite() && sample_rate_hz > 0.0,
             "sample rate {sample_rate_hz} Hz is not supported"
         );
         self.sample_rate_hz = sample_rate_hz as f64;

@@ -347,6 +347,50 @@ fn any_rate_and_any_block_size_give_the_same_note() {
 }
 
 #[test]
+fn the_plugins_play_at_any_rate_a_host_asks() {
+    // The extremes the validators try: the note plays in tune where it lies below Nyquist, and
+    // every sample is a finite, sensible level; the effect rings its input.
+    for rate in [1_234.567_8, 1_234_567.8] {
+        let samples = (rate * 0.5) as usize;
+        let at = (rate * 0.1) as usize;
+        let note = run(&Script {
+            rate,
+            events: &[(at, Send::On(69, 1.0))],
+            blocks: &[256, 1, 1_000],
+            ..Script::new(INSTRUMENT, samples)
+        });
+        for channel in [&note.left, &note.right] {
+            assert!(
+                channel.iter().all(|v| v.is_finite() && v.abs() < 4.0),
+                "{rate} Hz: output out of range"
+            );
+        }
+        assert!(peak(&note.left[at..]) > 0.01, "{rate} Hz: no note");
+        let got = pitch_hz(&note.left[at + 10..], rate, 300.0, 600.0);
+        assert!(
+            (got / 440.0 - 1.0).abs() < 0.005,
+            "{rate} Hz: A4 at {got} Hz"
+        );
+        let click: Vec<f32> = (0..samples).map(|i| if i == at { 0.5 } else { 0.0 }).collect();
+        let input = [click.clone(), click];
+        let rung = run(&Script {
+            rate,
+            events: &[(0, Send::Param("mix", 1.0))],
+            input: Some(&input),
+            ..Script::new(EFFECT, samples)
+        });
+        assert!(
+            rung.left.iter().all(|v| v.is_finite() && v.abs() < 4.0),
+            "{rate} Hz: effect output out of range"
+        );
+        assert!(
+            peak(&rung.left[at + (rate * 0.05) as usize..]) > 1e-4,
+            "{rate} Hz: the effect does not ring"
+        );
+    }
+}
+
+#[test]
 fn taps_on_the_exciter_strike_in_trigger_mode() {
     // Three taps into the exciter input, input mode "trigger" (enum index 2).
     let taps: Vec<f32> = (0..48_000)

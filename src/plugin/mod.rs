@@ -35,9 +35,6 @@ pub type ModalResonatorFx = ModalPlugin<Effect>;
 /// Most note events (host events plus detected onsets) handled per block; more are dropped.
 const MAX_EVENTS: usize = 2048;
 
-/// Lowest sample rate the engine runs at, in Hz.
-const MIN_SAMPLE_RATE_HZ: f32 = 8_000.0;
-
 /// How long the bank that was playing fades out when another is loaded, in seconds.
 const BANK_CROSSFADE_S: f32 = 0.05;
 
@@ -382,7 +379,8 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         _context: &mut impl ActivateContext<Self>,
     ) -> bool {
         let rate = config.sample_rate;
-        if !(rate.is_finite() && rate >= MIN_SAMPLE_RATE_HZ) {
+        // Any rate a host asks plays: modes above the engine's limit below Nyquist are left out.
+        if !(rate.is_finite() && rate > 0.0) {
             return false;
         }
         let max_block = config.max_buffer_size.max(1) as usize;
