@@ -95,7 +95,14 @@ fn mode_bins_avx2(lanes: &Lanes, pole: &Pole, out: Out<'_>) {
 #[inline(always)]
 fn mode_bins_portable(lanes: &Lanes, pole: &Pole, out: Out<'_>) {
     match out.derivatives {
-        None => each_bin::<false>(lanes, pole, out.unit, out.gain, [&mut [], &mut [], &mut []], 0.0),
+        None => each_bin::<false>(
+            lanes,
+            pole,
+            out.unit,
+            out.gain,
+            [&mut [], &mut [], &mut []],
+            0.0,
+        ),
         Some((d, tau_gain)) => each_bin::<true>(lanes, pole, out.unit, out.gain, d, tau_gain),
     }
 }
@@ -237,7 +244,13 @@ mod tests {
             .collect();
         // A taper with zero ends, as a band's.
         let taper: Vec<f64> = (0..bins)
-            .map(|j| if (5..=240).contains(&j) { 0.5 + 0.4 * (j as f64).sin() } else { 0.0 })
+            .map(|j| {
+                if (5..=240).contains(&j) {
+                    0.5 + 0.4 * (j as f64).sin()
+                } else {
+                    0.0
+                }
+            })
             .collect();
         let s = Complex64::new(-3e-4, TAU * 330.5 / fft_len);
         let tau = 2.5;
@@ -286,7 +299,10 @@ mod tests {
                     assert_eq!(*v, zero, "output {which} bin {j} is outside the taper");
                     continue;
                 };
-                assert!((g - v).norm() <= 1e-12 * peak, "output {which} bin {j}: {g} vs {v}");
+                assert!(
+                    (g - v).norm() <= 1e-12 * peak,
+                    "output {which} bin {j}: {g} vs {v}"
+                );
             }
         }
         assert_eq!(only_unit, got[0]);

@@ -42,7 +42,12 @@ fn dot_portable(x: &[f64], y: &[f64]) -> f64 {
     let (x, y) = (&x[..n], &y[..n]);
     let mut sums = [0.0; DOT_LANES];
     let (xs, ys) = (x.chunks_exact(DOT_LANES), y.chunks_exact(DOT_LANES));
-    let tail: f64 = xs.remainder().iter().zip(ys.remainder()).map(|(a, b)| a * b).sum();
+    let tail: f64 = xs
+        .remainder()
+        .iter()
+        .zip(ys.remainder())
+        .map(|(a, b)| a * b)
+        .sum();
     for (a, b) in xs.zip(ys) {
         for j in 0..DOT_LANES {
             sums[j] += a[j] * b[j];
@@ -318,8 +323,14 @@ mod tests {
             let y: Vec<f64> = (0..n + 3).map(|i| (i as f64 * 1.13).cos() - 0.2).collect();
             let plain: f64 = x.iter().zip(&y).map(|(a, b)| a * b).sum();
             let scale: f64 = x.iter().zip(&y).map(|(a, b)| (a * b).abs()).sum();
-            assert!((dot(&x, &y) - plain).abs() <= 1e-14 * scale.max(1.0), "length {n}");
-            assert!((dot(&y, &x) - plain).abs() <= 1e-14 * scale.max(1.0), "length {n}");
+            assert!(
+                (dot(&x, &y) - plain).abs() <= 1e-14 * scale.max(1.0),
+                "length {n}"
+            );
+            assert!(
+                (dot(&y, &x) - plain).abs() <= 1e-14 * scale.max(1.0),
+                "length {n}"
+            );
         }
     }
 

@@ -249,7 +249,11 @@ impl<'a> Target<'a> {
                 gain,
                 derivatives: derivatives.map(|[dm, da, dt]| {
                     (
-                        [&mut dm[live.clone()], &mut da[live.clone()], &mut dt[live.clone()]],
+                        [
+                            &mut dm[live.clone()],
+                            &mut da[live.clone()],
+                            &mut dt[live.clone()],
+                        ],
                         m.gain,
                     )
                 }),
@@ -606,9 +610,16 @@ fn subset_gains(gram: &[f64], rhs: &[f64], subset: &[usize]) -> Vec<f64> {
     }
     let mut a: Vec<Complex64> = subset
         .iter()
-        .flat_map(|&i| subset.iter().map(move |&j| Complex64::new(gram[i * n + j], 0.0)))
+        .flat_map(|&i| {
+            subset
+                .iter()
+                .map(move |&j| Complex64::new(gram[i * n + j], 0.0))
+        })
         .collect();
-    let mut b: Vec<Complex64> = subset.iter().map(|&i| Complex64::new(rhs[i], 0.0)).collect();
+    let mut b: Vec<Complex64> = subset
+        .iter()
+        .map(|&i| Complex64::new(rhs[i], 0.0))
+        .collect();
     solve(&mut a, &mut b, k, 1);
     b.iter().map(|g| g.re).collect()
 }
