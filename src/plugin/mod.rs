@@ -19,6 +19,7 @@ use nice_plug_egui::{EguiEditor, EguiEditorState};
 pub use bank_loader::{bank_from_state, build_engine, LoadedEngine, DEFAULT_FACTORY_BANK};
 pub use kind::{Effect, Instrument, Kind};
 
+use crate::dsp::denormal::flush_subnormals;
 use crate::dsp::onset::OnsetDetector;
 use crate::editor::{self, EditorApp, EditorLinks, EditorShared, AUDITION_NOTE_ID};
 use crate::engine::{EndedVoice, NoteEvent as EngineEvent, MAX_POLYPHONY};
@@ -510,6 +511,11 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
             }
             self.render_segment(channels, exciter, start, end, context);
             start = end;
+        }
+        // No subnormal sample leaves the plugin: a dry path copies what the host sends, and the
+        // plugins after this one may not flush.
+        for channel in channels.iter_mut() {
+            flush_subnormals(&mut channel[..n]);
         }
         // Controllers timed past the block's end (hosts should not send them) act now.
         for &(_, change) in &self.changes[next_change..] {
