@@ -221,6 +221,10 @@ pub struct ModalParams {
     pub mpe: BoolParam,
     #[id = "mpebnd"]
     pub mpe_bend_range: FloatParam,
+    /// The host's bypass button: the output crossfades to the effect's dry input, or to silence
+    /// for the instrument; the object keeps ringing underneath.
+    #[id = "bypass"]
+    pub bypass: BoolParam,
     /// Perceptual pruning and the mode budget.
     #[nested(group = "Pruning")]
     pub pruning: PruningParams,
@@ -367,6 +371,7 @@ impl ModalParams {
             mod_wheel_target: EnumParam::new("Mod wheel", ExpressionTarget::Position),
             pressure_target: EnumParam::new("Pressure", ExpressionTarget::Damping),
             mpe: BoolParam::new("MPE", false),
+            bypass: BoolParam::new("Bypass", false).make_bypass(),
             mpe_bend_range: FloatParam::new(
                 "MPE bend range",
                 MPE_DEFAULT_BEND_RANGE,

@@ -147,7 +147,7 @@ const PARAM_IDS: &[&str] = &[
     "mat", "q", "tilt", "size", "keytrk", "fine", "bendrg", "posx", "posy", "posvar", "exc",
     "hard", "velsns", "velhrd", "reldmp", "trunc", "poly", "width", "gain", "inmode", "ingain",
     "trigth", "retrig", "mix", "modwhl", "press", "mpe", "mpebnd", "prune", "maskav", "spl",
-    "prfrm", "budget", "load",
+    "prfrm", "budget", "load", "bypass",
 ];
 
 #[test]
@@ -464,6 +464,81 @@ fn no_subnormal_sample_leaves_either_plugin_whatever_the_host_does() {
             }
         }
     }
+}
+
+#[test]
+fn the_bypass_fades_to_the_dry_input_or_to_silence_and_back() {
+    // Parameters change at the start of the host's block that holds the change.
+    let fade = (0.01 * RATE) as usize;
+    let block_start = |at: usize| at / BLOCK * BLOCK;
+    // The effect, wet, bypassed at 0.1 s: from the end of the fade its output is its input.
+    let noise: Vec<f32> = (0..24_000)
+        .map(|i| (i as f32 * 0.731).sin() * 0.3 + (i as f32 * 0.117).cos() * 0.2)
+        .collect();
+    let input = [noise.clone(), noise.clone()];
+    let at = 4_800;
+    let fx = run(&Script {
+        events: &[
+            (0, Send::Param("mix", 1.0)),
+            (at, Send::Param("bypass", 1.0)),
+        ],
+        input: Some(&input),
+        ..Script::new(EFFECT, 24_000)
+    });
+    assert!(
+        fx.left[..block_start(at)]
+            .iter()
+            .zip(&noise)
+            .any(|(a, b)| (a - b).abs() > 0.01),
+        "the wet effect already passes its input"
+    );
+    for i in block_start(at) + fade..24_000 {
+        assert!(
+            (fx.left[i] - noise[i]).abs() < 1e-6,
+            "bypassed sample {i}: {} vs {}",
+            fx.left[i],
+            noise[i]
+        );
+    }
+    // The instrument: a ringing note bypassed at 0.2 s falls silent without a click, and
+    // sounds again when the bypass is lifted at 0.3 s.
+    let (on, off) = (block_start(9_600), block_start(14_400));
+    let inst = run(&Script {
+        events: &[
+            (0, Send::On(69, 1.0)),
+            (on, Send::Param("bypass", 1.0)),
+            (off, Send::Param("bypass", 0.0)),
+        ],
+        ..Script::new(INSTRUMENT, 24_000)
+    });
+    let l = &inst.left;
+    assert!(peak(&l[on - 480..on]) > 0.01, "no note before the bypass");
+    assert!(
+        l[on + fade..off].iter().all(|&v| v == 0.0),
+        "the bypassed instrument still sounds"
+    );
+    assert!(peak(&l[off + fade..]) > 0.005, "no sound after the bypass");
+    // No step larger than the note's own: the fade does not click.
+    let step = |x: &[f32]| {
+        x.windows(2)
+            .map(|w| (w[1] - w[0]).abs())
+            .fold(0.0, f32::max)
+    };
+    let ringing = step(&l[on - 480..on]);
+    assert!(
+        step(&l[on - 1..on + fade + 1]) <= ringing,
+        "the fade out clicks"
+    );
+    assert!(
+        step(&l[off - 1..off + fade + 1]) <= ringing,
+        "the fade in clicks"
+    );
+    // It fades rather than cuts: halfway through, the note is neither whole nor gone.
+    let half = peak(&l[on + fade / 2 - 50..on + fade / 2 + 50]);
+    assert!(
+        half > 0.1 * peak(&l[on - 100..on]) && half < 0.9 * peak(&l[on - 100..on]),
+        "no fade: {half}"
+    );
 }
 
 #[test]

@@ -36,6 +36,9 @@ pub type ModalResonatorFx = ModalPlugin<Effect>;
 /// Most note events (host events plus detected onsets) handled per block; more are dropped.
 const MAX_EVENTS: usize = 2048;
 
+/// How long the output takes to fade to the bypassed sound and back, in seconds.
+const BYPASS_FADE_S: f32 = 0.01;
+
 /// How long the bank that was playing fades out when another is loaded, in seconds.
 const BANK_CROSSFADE_S: f32 = 0.05;
 
@@ -105,6 +108,9 @@ pub struct ModalPlugin<K: Kind> {
     last_key: Option<u8>,
     /// Dry/wet mix at the end of the last block; `None` after a reset (no ramp needed).
     wet: Option<f32>,
+    /// Share of the output bypassed at the end of the last segment (0 playing, 1 bypassed);
+    /// `None` after a reset (no fade needed).
+    bypassed: Option<f32>,
     /// The editor's size and whether it is open.
     editor_state: Arc<EguiEditorState>,
     /// Meters for the editor and its strike pad's requests.
@@ -133,6 +139,7 @@ impl<K: Kind> Default for ModalPlugin<K> {
             expression: Expression::default(),
             last_key: None,
             wet: None,
+            bypassed: None,
             editor_state: editor::default_state(),
             editor_shared: Arc::new(EditorShared::new()),
             audition_key: None,
@@ -267,6 +274,33 @@ impl<K: Kind> ModalPlugin<K> {
                 }
             }
             self.wet = Some(to);
+        }
+        self.bypass(channels, start, end);
+    }
+
+    /// The host's bypass over samples `start..end`: a fade to the effect's dry input (in
+    /// `self.dry`) or to silence, over [`BYPASS_FADE_S`].
+    fn bypass(&mut self, channels: &mut [&mut [f32]], start: usize, end: usize) {
+        let to = if self.params.bypass.value() { 1.0 } else { 0.0 };
+        let from = self.bypassed.unwrap_or(to);
+        self.bypassed = Some(to);
+        if from == 0.0 && to == 0.0 {
+            return;
+        }
+        let rate = f32::from_bits(self.shared.sample_rate_bits.load(Ordering::Acquire));
+        let step = 1.0 / (BYPASS_FADE_S * rate).max(1.0);
+        for (c, channel) in channels.iter_mut().take(2).enumerate() {
+            let mut share = from;
+            for (i, out) in channel[start..end].iter_mut().enumerate() {
+                share = if to > share {
+                    (share + step).min(to)
+                } else {
+                    (share - step).max(to)
+                };
+                let dry = if K::IS_EFFECT { self.dry[c][i] } else { 0.0 };
+                *out = (1.0 - share) * *out + share * dry;
+            }
+            self.bypassed = Some(share);
         }
     }
 }
@@ -439,6 +473,7 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         }
         self.onsets.reset();
         self.wet = None;
+        self.bypassed = None;
         // A reset ends every note at once, for the host as well, and forgets the last key: a
         // host's test note before a reset leaves nothing behind.
         self.engines.drop_outgoing();
