@@ -38,8 +38,8 @@ use super::subband::Band;
 /// Iterations of Levenberg-Marquardt.
 const MAX_ITERATIONS: usize = 30;
 
-/// Iterations of Levenberg-Marquardt after each mode the selection drops: the last fit kept is
-/// refined in full.
+/// Iterations of Levenberg-Marquardt after each mode dropped as one the data cannot tell from
+/// another: the last fit kept is refined in full.
 const SELECTION_ITERATIONS: usize = 10;
 
 /// Iterations of Levenberg-Marquardt on all the modes, before any is dropped.
