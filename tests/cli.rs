@@ -173,6 +173,12 @@ fn identical_runs_write_identical_files() {
             out,
             "--set",
             "position_variation=0.4",
+            // Pruning and a fixed budget repeat exactly too; only the measured Target load
+            // may not.
+            "--set",
+            "pruning=on",
+            "--set",
+            "mode_budget=3",
         ]
     };
     for name in ["a.wav", "b.wav"] {
