@@ -1192,3 +1192,56 @@ fn validate_takes_factory_preset_names() {
     let out = run(dir.path(), &["validate", "no-such-bank"]);
     assert!(!out.status.success());
 }
+
+#[test]
+fn an_interrupted_render_leaves_nothing_behind() {
+    for signal in [libc::SIGINT, libc::SIGTERM] {
+        let dir = tempfile::tempdir().unwrap();
+        // A mode that barely decays rings to the end: 600 s of 32-bit stereo, a 230 MB file.
+        let mut bank = common::simple_bank(&[(440.0, 0.01, 1.0)]);
+        bank.root_hz = Some(440.0);
+        std::fs::write(
+            dir.path().join("bank.json"),
+            serde_json::to_string(&bank).unwrap(),
+        )
+        .unwrap();
+        let mut child = Command::new(env!("CARGO_BIN_EXE_modal-resonator"))
+            .current_dir(dir.path())
+            .args([
+                "render",
+                "bank.json",
+                "--notes",
+                "69:1@0+600",
+                "--max-seconds",
+                "600",
+                "--bits",
+                "32",
+                "-o",
+                "out.wav",
+            ])
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        // Interrupt it while its temporary file is being written.
+        let started = std::time::Instant::now();
+        loop {
+            if entries(dir.path()).iter().any(|n| n.starts_with(".modal-resonator-")) {
+                break;
+            }
+            if let Some(status) = child.try_wait().unwrap() {
+                panic!("signal {signal}: the render ended ({status}) before it was interrupted");
+            }
+            assert!(started.elapsed().as_secs() < 120, "no temporary file appeared");
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        // SAFETY: sends a signal to the child this test started and has not reaped.
+        assert_eq!(unsafe { libc::kill(child.id() as i32, signal) }, 0);
+        let status = child.wait().unwrap();
+        assert_eq!(status.code(), Some(130), "signal {signal}: {status}");
+        assert_eq!(
+            entries(dir.path()),
+            ["bank.json"],
+            "signal {signal} left files behind"
+        );
+    }
+}

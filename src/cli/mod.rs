@@ -18,7 +18,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use modal_resonator::model::factory::{factory_bank, factory_banks, factory_slug};
-use modal_resonator::model::staged::destination;
+use modal_resonator::model::staged::{destination, remove_temporaries};
 use modal_resonator::model::{load_bank_file, Bank};
 
 /// Modal Resonator: modal-synthesis instrument and bank tool.
@@ -85,6 +85,7 @@ pub fn main() -> ExitCode {
     let standalone = matches!(cli.command, Some(Command::Play { .. }) | None);
     if !standalone {
         quiet_on_closed_pipe();
+        clean_up_on_interrupt();
     }
     let result = match cli.command {
         Some(Command::Render(args)) => render::run(&args),
@@ -116,6 +117,17 @@ fn quiet_on_closed_pipe() {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
+}
+
+/// Ctrl-C, SIGTERM and SIGHUP end the command with status 130 after removing the temporary
+/// files beside its outputs; the outputs keep what they held. Not for the standalone, which
+/// stops its audio on Ctrl-C itself.
+fn clean_up_on_interrupt() {
+    // Only fails when a handler is already set, which nothing else here does.
+    let _ = ctrlc::set_handler(|| {
+        remove_temporaries();
+        std::process::exit(130);
+    });
 }
 
 /// Loads the bank named on the command line: a bank file (validated) if `arg` is a path that

@@ -8,6 +8,7 @@
 
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use tempfile::NamedTempFile;
 
@@ -46,6 +47,33 @@ impl StagedFile {
             .persist(&self.path)
             .map(|_| ())
             .map_err(|e| e.error)
+    }
+}
+
+/// Every temporary file this process made beside a destination: a signal that ends the process
+/// removes those still there ([`remove_temporaries`]). Those renamed into place or dropped are
+/// gone already.
+static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// Notes a temporary file for [`remove_temporaries`].
+fn track(path: &Path) {
+    if let Ok(mut paths) = TEMPORARIES.lock() {
+        // Forget those already gone, so a long session's list stays short.
+        paths.retain(|p| p.exists());
+        paths.push(path.to_path_buf());
+    }
+}
+
+/// Removes every temporary file this process made that is still there: for a process ended by a
+/// signal, whose destructors do not run. The destinations keep what they held (a set of files
+/// interrupted halfway through [`commit_all`] keeps the ones already replaced).
+pub fn remove_temporaries() {
+    let paths = match TEMPORARIES.lock() {
+        Ok(paths) => paths.clone(),
+        Err(poisoned) => poisoned.into_inner().clone(),
+    };
+    for path in paths {
+        let _ = std::fs::remove_file(path);
     }
 }
 
@@ -143,6 +171,7 @@ pub fn temp_beside(
     #[cfg(unix)]
     builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
     let temp = builder.tempfile_in(dir)?;
+    track(temp.path());
     if let Some(permissions) = &destination.permissions {
         temp.as_file().set_permissions(permissions.clone())?;
     }
@@ -197,6 +226,7 @@ fn keep_copy(path: &Path) -> io::Result<Option<tempfile::TempPath>> {
         .suffix(".tmp")
         .tempfile_in(dir)?
         .into_temp_path();
+    track(&backup);
     std::fs::copy(path, &backup)?;
     Ok(Some(backup))
 }
