@@ -38,7 +38,7 @@ pub struct PreparedBank {
     pub num_positions: usize,
     /// The positions, normalised.
     pub positions: PositionMap,
-    /// MIDI key (fractional) of the bank's root pitch.
+    /// The MIDI key that plays the bank at its own pitch: the one nearest its root pitch.
     pub root_key: f64,
     /// The bank's own quality factor: median of `pi f / d` (with `d` at least
     /// `MIN_DECAY_PER_S`). Material Q scales decays relative to it.
@@ -76,7 +76,9 @@ impl PreparedBank {
             gains_by_position: Vec::new(),
             num_positions: k,
             positions: PositionMap::new(&coords),
-            root_key: hz_to_midi_key(bank.effective_root_hz()),
+            // The key nearest the root plays the bank as authored, off the equal-tempered grid
+            // or not: a fitted cowbell sounds on its root key as it was recorded.
+            root_key: hz_to_midi_key(bank.effective_root_hz()).round(),
             reference_q,
             normalization: 1.0,
         };
