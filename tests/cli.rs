@@ -1225,13 +1225,19 @@ fn an_interrupted_render_leaves_nothing_behind() {
         // Interrupt it while its temporary file is being written.
         let started = std::time::Instant::now();
         loop {
-            if entries(dir.path()).iter().any(|n| n.starts_with(".modal-resonator-")) {
+            if entries(dir.path())
+                .iter()
+                .any(|n| n.starts_with(".modal-resonator-"))
+            {
                 break;
             }
             if let Some(status) = child.try_wait().unwrap() {
                 panic!("signal {signal}: the render ended ({status}) before it was interrupted");
             }
-            assert!(started.elapsed().as_secs() < 120, "no temporary file appeared");
+            assert!(
+                started.elapsed().as_secs() < 120,
+                "no temporary file appeared"
+            );
             std::thread::sleep(std::time::Duration::from_millis(1));
         }
         // SAFETY: sends a signal to the child this test started and has not reaped.

@@ -294,12 +294,19 @@ fn the_key_nearest_an_off_grid_root_plays_the_bank_as_authored() {
     // 452 Hz is A4 + 47 cents: A4 plays it at 452 Hz, the other keys relative to it.
     let mut bank = simple_bank(&[(452.0, 1.0, 1.0)]);
     bank.root_hz = Some(452.0);
-    for (key, want) in [(69, 452.0), (81, 904.0), (64, 452.0 * 2f64.powf(-5.0 / 12.0))] {
+    for (key, want) in [
+        (69, 452.0),
+        (81, 904.0),
+        (64, 452.0 * 2f64.powf(-5.0 / 12.0)),
+    ] {
         let mut e = engine(&bank, RATE);
         let (l, _) = render(&mut e, &[on(0, key, 1.0)], 0.5, 512);
         let got = spectral_peak_hz(&l, RATE as f64, want * 0.9, want * 1.1);
         let cents = 1200.0 * (got / want).log2();
-        assert!(cents.abs() < 1.0, "key {key}: {got} Hz, {cents:.2} cents off {want}");
+        assert!(
+            cents.abs() < 1.0,
+            "key {key}: {got} Hz, {cents:.2} cents off {want}"
+        );
     }
 }
 
