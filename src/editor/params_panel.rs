@@ -56,7 +56,12 @@ impl<T: Enum + PartialEq + 'static> ChoiceParam for EnumParam<T> {
 fn groups(p: &ModalParams) -> Vec<(&'static str, Vec<Control<'_>>)> {
     use Control::*;
     // The instrument's dry/wet mixes its exciter input, the effect's its audio input.
-    let output = vec![Float(&p.output_gain), Float(&p.width), Float(&p.dry_wet)];
+    let output = vec![
+        Float(&p.output_gain),
+        Float(&p.width),
+        Float(&p.dry_wet),
+        Bool(&p.bypass),
+    ];
     vec![
         (
             "Object",
