@@ -401,13 +401,8 @@ fn the_plugins_play_at_any_rate_a_host_asks() {
 fn no_subnormal_sample_leaves_either_plugin_whatever_the_host_does() {
     // Randomised parameters, rates, block sizes and notes, with subnormal input on the input
     // port between bursts of noise: every output sample is finite and not subnormal.
-    let mut seed = 0x9e37_79b9_u32;
-    let mut next = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 17;
-        seed ^= seed << 5;
-        seed as f64 / u32::MAX as f64
-    };
+    let mut rng = modal_resonator::dsp::rng::Rng::new(0x9e37_79b9);
+    let mut next = move || rng.next_u32() as f64 / u32::MAX as f64;
     let rates = [1_234.567_8, 11_025.0, 44_100.0, 48_000.0, 96_000.0];
     for case in 0..12 {
         let plugin = if case % 2 == 0 { INSTRUMENT } else { EFFECT };

@@ -517,12 +517,12 @@ impl<'a> Target<'a> {
         let mut kept: Vec<usize> = (0..fit.modes.len()).collect();
         let mut gains: Vec<f64> = fit.modes.iter().map(|m| m.gain).collect();
         let mut length = self.description_length(kept.len(), error);
+        let n = units.len();
         while !kept.is_empty() {
+            // A mode's weighted energy: its gain squared times its Gram diagonal.
+            let energy = |i: usize| gains[i] * gains[i] * gram[kept[i] * n + kept[i]];
             let weakest = (0..kept.len())
-                .min_by(|&a, &b| {
-                    let energy = |i: usize| gains[i] * gains[i] * gram[kept[i] * (units.len() + 1)];
-                    energy(a).total_cmp(&energy(b))
-                })
+                .min_by(|&a, &b| energy(a).total_cmp(&energy(b)))
                 .expect("not empty");
             let mut fewer = kept.clone();
             fewer.remove(weakest);
