@@ -18,7 +18,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use modal_resonator::model::factory::{factory_bank, factory_banks, factory_slug};
-use modal_resonator::model::staged::{destination, remove_temporaries};
+use modal_resonator::model::staged::{destination, exit_removing_temporaries};
 use modal_resonator::model::{load_bank_file, Bank};
 
 /// Modal Resonator: modal-synthesis instrument and bank tool.
@@ -124,10 +124,7 @@ fn quiet_on_closed_pipe() {
 /// stops its audio on Ctrl-C itself.
 fn clean_up_on_interrupt() {
     // Only fails when a handler is already set, which nothing else here does.
-    let _ = ctrlc::set_handler(|| {
-        remove_temporaries();
-        std::process::exit(130);
-    });
+    let _ = ctrlc::set_handler(|| exit_removing_temporaries(130));
 }
 
 /// Loads the bank named on the command line: a bank file (validated) if `arg` is a path that

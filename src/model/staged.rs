@@ -51,30 +51,39 @@ impl StagedFile {
 }
 
 /// Every temporary file this process made beside a destination: a signal that ends the process
-/// removes those still there ([`remove_temporaries`]). Those renamed into place or dropped are
+/// removes those still there ([`exit_removing_temporaries`]). Those renamed into place or dropped are
 /// gone already.
 static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
-/// Notes a temporary file for [`remove_temporaries`].
-fn track(path: &Path) {
-    if let Ok(mut paths) = TEMPORARIES.lock() {
-        // Forget those already gone, so a long session's list stays short.
-        paths.retain(|p| p.exists());
-        paths.push(path.to_path_buf());
-    }
+/// Makes a temporary file with `create` and notes it for [`exit_removing_temporaries`], both
+/// under the registry's lock: a signal handled meanwhile waits until the file is noted, so it
+/// cannot miss one.
+fn tracked<T>(create: impl FnOnce() -> io::Result<T>, path: impl Fn(&T) -> &Path) -> io::Result<T> {
+    let mut paths = match TEMPORARIES.lock() {
+        Ok(paths) => paths,
+        Err(poisoned) => poisoned.into_inner(),
+    };
+    let made = create()?;
+    // Forget those already gone, so a long session's list stays short.
+    paths.retain(|p| p.exists());
+    paths.push(path(&made).to_path_buf());
+    Ok(made)
 }
 
-/// Removes every temporary file this process made that is still there: for a process ended by a
-/// signal, whose destructors do not run. The destinations keep what they held (a set of files
-/// interrupted halfway through [`commit_all`] keeps the ones already replaced).
-pub fn remove_temporaries() {
+/// Removes every temporary file this process made that is still there, then ends the process
+/// with `code`: for a process ended by a signal, whose destructors do not run. The registry
+/// stays locked until the end, so no temporary file can be made after the sweep. The
+/// destinations keep what they held (a set of files interrupted halfway through
+/// [`commit_all`] keeps the ones already replaced).
+pub fn exit_removing_temporaries(code: i32) -> ! {
     let paths = match TEMPORARIES.lock() {
-        Ok(paths) => paths.clone(),
-        Err(poisoned) => poisoned.into_inner().clone(),
+        Ok(paths) => paths,
+        Err(poisoned) => poisoned.into_inner(),
     };
-    for path in paths {
+    for path in paths.iter() {
         let _ = std::fs::remove_file(path);
     }
+    std::process::exit(code)
 }
 
 /// Where a file written to a path lands.
@@ -170,8 +179,7 @@ pub fn temp_beside(
     builder.prefix(prefix).suffix(suffix);
     #[cfg(unix)]
     builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let temp = builder.tempfile_in(dir)?;
-    track(temp.path());
+    let temp = tracked(|| builder.tempfile_in(dir), |t| t.path())?;
     if let Some(permissions) = &destination.permissions {
         temp.as_file().set_permissions(permissions.clone())?;
     }
@@ -221,12 +229,16 @@ fn keep_copy(path: &Path) -> io::Result<Option<tempfile::TempPath>> {
         Some(dir) if !dir.as_os_str().is_empty() => dir,
         _ => Path::new("."),
     };
-    let backup = tempfile::Builder::new()
-        .prefix(".modal-previous-")
-        .suffix(".tmp")
-        .tempfile_in(dir)?
-        .into_temp_path();
-    track(&backup);
+    let backup = tracked(
+        || {
+            tempfile::Builder::new()
+                .prefix(".modal-previous-")
+                .suffix(".tmp")
+                .tempfile_in(dir)
+                .map(NamedTempFile::into_temp_path)
+        },
+        |t| t,
+    )?;
     std::fs::copy(path, &backup)?;
     Ok(Some(backup))
 }
