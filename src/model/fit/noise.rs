@@ -5,6 +5,11 @@
 //! percentile over the frames finds that level, and a median across neighbouring bins removes
 //! narrow peaks of modes that ring through the whole recording. The median follows a smooth noise
 //! colour (hum, hiss tilt) but not single modes.
+//!
+//! That holds only where the sound has died away before the file ends. Where it still falls over
+//! the last frames (a recording cut at a sampler's loop start, a short click, a cymbal still
+//! ringing), the quietest frames are the sound itself, and the noise is taken from where the
+//! recording does show it.
 
 use super::stft::Spectrogram;
 
@@ -18,6 +23,17 @@ const PERCENTILE_TO_MEAN: f64 = 0.223_143_551_314_209_75;
 /// Half-width of the median across frequency, in bins of the unpadded window: wide enough that a
 /// mode's main lobe (4 bins) is a minority.
 const MEDIAN_HALF_WIDTH_BINS: usize = 16;
+
+/// The last quarter of the frames is compared with the quarter before it: where their power,
+/// summed over a bin's neighbourhood, falls by more than this factor (3 dB), the sound is still
+/// dying away when the recording ends.
+const STILL_FALLING: f64 = 2.0;
+
+/// Where the recording never shows its noise, the noise is taken at most this many dB under the
+/// loudest bin of any frame: 10 dB under the modes the fit leaves out as inaudible beside the
+/// strongest (70 dB), so that every mode that may stay can stand clear of it. Lower, the level
+/// matching starts to give modes to the window's side lobes and the fit's rounding.
+const MAX_RANGE_DB: f64 = 80.0;
 
 /// Lowest noise power per bin relative to a full-scale sinusoid's (-150 dB): digital silence
 /// still has a finite floor.
@@ -54,6 +70,7 @@ impl NoiseSpectrum {
             })
             .collect();
         let half = MEDIAN_HALF_WIDTH_BINS * spec.pad;
+        let falling = still_falling(spec, half);
         let mut neighbourhood = Vec::with_capacity(2 * half + 1);
         let power = (0..bins)
             .map(|b| {
@@ -64,6 +81,31 @@ impl NoiseSpectrum {
                 let (_, median, _) = neighbourhood.select_nth_unstable_by(mid, f64::total_cmp);
                 median.max(floor)
             })
+            .collect::<Vec<f64>>();
+        // Where the sound still falls at the end, its quietest frames are sound, not noise: the
+        // recording never shows the noise there, which lies somewhere below. It is taken as low
+        // as the noise anywhere the recording does show it, but no lower than MAX_RANGE_DB
+        // under the loudest bin.
+        let shown = power
+            .iter()
+            .zip(&falling)
+            .filter(|(_, f)| !**f)
+            .map(|(p, _)| *p)
+            .fold(f64::INFINITY, f64::min);
+        let loudest = spec
+            .power
+            .iter()
+            .flat_map(|frame| frame.iter())
+            .fold(0.0, |a: f64, b| a.max(*b));
+        let lowest = (loudest * 10f64.powf(-MAX_RANGE_DB / 10.0)).max(if shown.is_finite() {
+            shown
+        } else {
+            floor
+        });
+        let power = power
+            .into_iter()
+            .zip(&falling)
+            .map(|(p, f)| if *f { p.min(lowest) } else { p })
             .collect();
         Self { power }
     }
@@ -73,6 +115,41 @@ impl NoiseSpectrum {
     pub fn at(&self, spec: &Spectrogram, freq_hz: f64) -> f64 {
         self.power[spec.bin_of(freq_hz)]
     }
+}
+
+/// For each bin of `spec`, whether the power around it (within `half` bins) still falls by
+/// [`STILL_FALLING`] from the next-to-last quarter of the frames to the last. With fewer than
+/// four frames, none is.
+fn still_falling(spec: &Spectrogram, half: usize) -> Vec<bool> {
+    let bins = spec.num_bins();
+    let frames = spec.power.len();
+    if frames < 4 {
+        return vec![false; bins];
+    }
+    let quarter = frames / 4;
+    let sum_over = |range: std::ops::Range<usize>| -> Vec<f64> {
+        let mut sum = vec![0.0; bins];
+        for frame in &spec.power[range] {
+            for (s, p) in sum.iter_mut().zip(frame) {
+                *s += p;
+            }
+        }
+        // Running sums over each bin's neighbourhood.
+        let mut prefix = Vec::with_capacity(bins + 1);
+        prefix.push(0.0);
+        for s in &sum {
+            prefix.push(prefix.last().copied().unwrap_or(0.0) + s);
+        }
+        (0..bins)
+            .map(|b| prefix[(b + half + 1).min(bins)] - prefix[b.saturating_sub(half)])
+            .collect()
+    };
+    let last = sum_over(frames - quarter..frames);
+    let before = sum_over(frames - 2 * quarter..frames - quarter);
+    last.iter()
+        .zip(&before)
+        .map(|(l, b)| *b > STILL_FALLING * *l)
+        .collect()
 }
 
 #[cfg(test)]
@@ -107,6 +184,42 @@ mod tests {
             let ratio_db = 10.0 * (noise.at(&spec, f) / expected).log10();
             assert!(
                 ratio_db.abs() < 1.5,
+                "{f} Hz: noise estimate off by {ratio_db:.2} dB"
+            );
+        }
+    }
+
+    #[test]
+    fn sound_still_dying_at_the_end_is_not_taken_for_noise() {
+        let rate = 48_000.0;
+        let sigma = 1e-4f64;
+        let mut rng = Rng::new(11);
+        // A dense band of modes (1-3 kHz, one every 5 Hz) still 30 dB over the noise when the
+        // recording ends, as a wood block's or a cymbal's sound cut short; white noise under it.
+        let tau = std::f64::consts::TAU;
+        let phases: Vec<f64> = (0..400)
+            .map(|_| std::f64::consts::PI * rng.bipolar() as f64)
+            .collect();
+        let x: Vec<f64> = (0..48_000)
+            .map(|n| {
+                let t = n as f64 / rate;
+                let ring: f64 = phases
+                    .iter()
+                    .enumerate()
+                    .map(|(k, p)| (tau * (1000.0 + 5.0 * k as f64) * t + p).sin())
+                    .sum();
+                sigma * 3f64.sqrt() * rng.bipolar() as f64 + 1e-2 * (-4.0 * t).exp() * ring
+            })
+            .collect();
+        let len = 2048;
+        let spec = Spectrogram::new(&x, rate, len, len / 4, 2);
+        let w = hann(len);
+        let noise = NoiseSpectrum::estimate(&spec, w.iter().sum());
+        let expected = sigma * sigma * w.iter().map(|v| v * v).sum::<f64>();
+        for f in [1500.0, 2000.0, 2500.0, 8000.0] {
+            let ratio_db = 10.0 * (noise.at(&spec, f) / expected).log10();
+            assert!(
+                ratio_db.abs() < 3.0,
                 "{f} Hz: noise estimate off by {ratio_db:.2} dB"
             );
         }
