@@ -434,8 +434,8 @@ fn help_lists_the_subcommands() {
 
 #[test]
 fn the_standalone_runs_headless_with_the_dummy_backend() {
-    // The standalone runs until stopped: start it, let it process for a while, then stop it.
-    // Its options work after `play` and with no subcommand at all.
+    // The standalone runs until stopped: start it, let it process for a while, then stop it as
+    // Ctrl-C does. Its options work after `play` and with no subcommand at all.
     let options = [
         "--backend",
         "dummy",
@@ -454,12 +454,80 @@ fn the_standalone_runs_headless_with_the_dummy_backend() {
             .expect("the binary runs");
         std::thread::sleep(std::time::Duration::from_secs(2));
         let still_running = child.try_wait().unwrap().is_none();
-        let _ = child.kill();
+        // SAFETY: sends a signal to the child this test started and has not reaped.
+        assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGINT) }, 0);
+        let started = std::time::Instant::now();
+        while child.try_wait().unwrap().is_none() {
+            if started.elapsed().as_secs() > 20 {
+                let _ = child.kill();
+                panic!("{play:?}: Ctrl-C did not stop the standalone");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
         let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(
             still_running,
-            "{play:?}: the standalone stopped by itself: {}",
-            String::from_utf8_lossy(&out.stderr)
+            "{play:?}: the standalone stopped by itself: {stderr}"
+        );
+        assert!(
+            out.status.success() && !stderr.to_lowercase().contains("error"),
+            "{play:?}: Ctrl-C ended the standalone with {}: {stderr}",
+            out.status
+        );
+    }
+}
+
+#[test]
+fn the_standalone_with_no_display_and_no_backend_named_says_so_and_exits() {
+    for play in [&["play"][..], &[]] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_modal-resonator"))
+            .args(play)
+            .env_remove("DISPLAY")
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("the binary runs");
+        let started = std::time::Instant::now();
+        while child.try_wait().unwrap().is_none() {
+            if started.elapsed().as_secs() > 20 {
+                let _ = child.kill();
+                panic!("{play:?}: the standalone blocked with nothing to play on");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        }
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{play:?}: {stderr}");
+        assert!(
+            stderr.contains("no display") && stderr.contains("--backend"),
+            "{play:?}: {stderr}"
+        );
+    }
+}
+
+#[test]
+fn play_help_lists_the_standalone_options() {
+    let out = Command::new(env!("CARGO_BIN_EXE_modal-resonator"))
+        .args(["play", "--help"])
+        .env_remove("DISPLAY")
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for option in [
+        "--backend",
+        "--sample-rate",
+        "--period-size",
+        "--input-device",
+    ] {
+        assert!(
+            text.contains(option),
+            "`play --help` lacks {option}:\n{text}"
         );
     }
 }

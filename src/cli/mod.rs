@@ -79,6 +79,13 @@ pub fn main() -> ExitCode {
         Cli {
             command: Some(Command::Play { args: argv }),
         }
+    } else if argv.first().is_some_and(|a| a == "play") {
+        // Everything after `play` is the standalone's, `--help` too, which lists its options.
+        Cli {
+            command: Some(Command::Play {
+                args: argv[1..].to_vec(),
+            }),
+        }
     } else {
         Cli::parse()
     };

@@ -8,7 +8,7 @@ mod kind;
 mod poly;
 
 use std::marker::PhantomData;
-use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, AtomicU64, Ordering};
 use std::sync::{Arc, RwLock};
 use std::time::Instant;
 
@@ -27,6 +27,16 @@ use crate::params::{InputMode, ModalParams, STATE_FORMAT, STATE_FORMAT_FIELD};
 use engines::Engines;
 use events::{ControlChange, Expression};
 use poly::PolyTable;
+
+/// Set by a standalone with no display: its plugin then offers no editor, so the standalone
+/// plays headless until it is stopped, and stopping it is no error.
+static WITHOUT_EDITOR: AtomicBool = AtomicBool::new(false);
+
+/// Makes the plugins of this process offer no editor: for a standalone on a machine with no
+/// display, where opening the window can only fail.
+pub fn play_without_editor() {
+    WITHOUT_EDITOR.store(true, Ordering::Relaxed);
+}
 
 /// The instrument plugin.
 pub type ModalResonator = ModalPlugin<Instrument>;
@@ -347,6 +357,9 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
     }
 
     fn editor(&mut self, _async_executor: AsyncExecutor<Self>) -> Option<Self::Editor> {
+        if WITHOUT_EDITOR.load(Ordering::Relaxed) {
+            return None;
+        }
         let shared = self.shared.clone();
         let app = EditorApp::new(EditorLinks {
             params: self.params.clone(),
