@@ -123,6 +123,27 @@ impl Rendered {
             .fold(0.0, |a, x| a.max(x.abs()))
     }
 
+    /// Samples of either channel beyond full scale: clipped in an integer file.
+    pub fn clipped_samples(&self) -> usize {
+        self.left
+            .iter()
+            .chain(&self.right)
+            .filter(|x| x.abs() > 1.0)
+            .count()
+    }
+
+    /// Scales both channels so that the peak lands at `peak_dbfs`. A silent render stays
+    /// silent.
+    pub fn normalize(&mut self, peak_dbfs: f32) {
+        let peak = self.peak();
+        if peak > 0.0 {
+            let scale = 10f32.powf(peak_dbfs / 20.0) / peak;
+            for x in self.left.iter_mut().chain(self.right.iter_mut()) {
+                *x *= scale;
+            }
+        }
+    }
+
     /// Peak level in dBFS (negative infinity for silence).
     pub fn peak_dbfs(&self) -> f32 {
         match self.peak() {

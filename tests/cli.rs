@@ -479,6 +479,88 @@ fn the_standalone_runs_headless_with_the_dummy_backend() {
 }
 
 #[test]
+fn a_clipping_render_warns_and_normalize_sets_the_peak() {
+    let dir = dir_with_bank();
+    // Eight full-velocity notes struck together.
+    let chord = "57:1@0, 60:1@0, 64:1@0, 67:1@0, 69:1@0, 72:1@0, 76:1@0, 79:1@0";
+    let args = |extra: &[&'static str]| {
+        let mut a = vec!["render", "bank.json", "--notes", chord, "--bits", "16"];
+        a.extend_from_slice(extra);
+        a
+    };
+    let out = run(dir.path(), &args(&["-o", "loud.wav"]));
+    assert!(out.status.success(), "{}", stderr(&out));
+    let warning = stderr(&out);
+    assert!(
+        warning.contains("warning: the render peaks at +")
+            && warning.contains("clipped")
+            && warning.contains("--normalize"),
+        "stderr: {warning}"
+    );
+    for target in [-1.0f64, -12.0] {
+        let level = format!("{target}");
+        let out = run(
+            dir.path(),
+            &[
+                "render",
+                "bank.json",
+                "--notes",
+                chord,
+                "--bits",
+                "16",
+                "--normalize",
+                &level,
+                "-o",
+                "normal.wav",
+            ],
+        );
+        assert!(out.status.success(), "{}", stderr(&out));
+        assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
+        let mut reader = hound::WavReader::open(dir.path().join("normal.wav")).unwrap();
+        let peak = reader
+            .samples::<i16>()
+            .map(|s| s.unwrap().unsigned_abs())
+            .max()
+            .unwrap();
+        let peak_dbfs = 20.0 * (peak as f64 / 32_768.0).log10();
+        assert!(
+            (peak_dbfs - target).abs() < 0.05,
+            "--normalize {target}: peak {peak_dbfs:.3} dBFS"
+        );
+    }
+    let out = run(dir.path(), &args(&["--normalize", "3", "-o", "bad.wav"]));
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("from -100 to 0"), "{}", stderr(&out));
+}
+
+#[test]
+fn a_silent_render_warns_and_exits_with_its_own_status() {
+    let dir = tempfile::tempdir().unwrap();
+    // A bank whose only mode lies above what 8 kHz can play, and one with no gain anywhere.
+    for (name, mode) in [
+        ("high.json", (6_000.0, 5.0, 1.0)),
+        ("mute.json", (440.0, 5.0, 0.0)),
+    ] {
+        let mut bank = common::simple_bank(&[mode]);
+        bank.root_hz = Some(440.0);
+        std::fs::write(dir.path().join(name), serde_json::to_string(&bank).unwrap()).unwrap();
+        let out = run(
+            dir.path(),
+            &[
+                "render", name, "--notes", "69:1@0", "--rate", "8000", "-o", "out.wav",
+            ],
+        );
+        assert_eq!(out.status.code(), Some(3), "{name}: {}", stderr(&out));
+        assert!(
+            stderr(&out).contains("warning: the render is silent"),
+            "{name}: {}",
+            stderr(&out)
+        );
+        assert!(dir.path().join("out.wav").is_file(), "{name}: no file");
+    }
+}
+
+#[test]
 fn the_standalone_with_no_display_and_no_backend_named_says_so_and_exits() {
     for play in [&["play"][..], &[]] {
         let mut child = Command::new(env!("CARGO_BIN_EXE_modal-resonator"))

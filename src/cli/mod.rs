@@ -96,18 +96,18 @@ pub fn main() -> ExitCode {
     }
     let result = match cli.command {
         Some(Command::Render(args)) => render::run(&args),
-        Some(Command::Fit(args)) => fit::run(&args),
-        Some(Command::Shape(args)) => shape::run(&args),
-        Some(Command::Compress(args)) => compress::run(&args),
-        Some(Command::Validate { files }) => validate::run(&files),
-        Some(Command::Info { bank }) => info::run(&bank),
-        Some(Command::List) => list::run(),
-        Some(Command::Schema) => schema::run(),
-        Some(Command::Play { args }) => play::run(args),
-        None => play::run(Vec::new()),
+        Some(Command::Fit(args)) => fit::run(&args).map(|()| ExitCode::SUCCESS),
+        Some(Command::Shape(args)) => shape::run(&args).map(|()| ExitCode::SUCCESS),
+        Some(Command::Compress(args)) => compress::run(&args).map(|()| ExitCode::SUCCESS),
+        Some(Command::Validate { files }) => validate::run(&files).map(|()| ExitCode::SUCCESS),
+        Some(Command::Info { bank }) => info::run(&bank).map(|()| ExitCode::SUCCESS),
+        Some(Command::List) => list::run().map(|()| ExitCode::SUCCESS),
+        Some(Command::Schema) => schema::run().map(|()| ExitCode::SUCCESS),
+        Some(Command::Play { args }) => play::run(args).map(|()| ExitCode::SUCCESS),
+        None => play::run(Vec::new()).map(|()| ExitCode::SUCCESS),
     };
     match result {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(message) => {
             eprintln!("error: {message}");
             ExitCode::FAILURE

@@ -2,6 +2,7 @@
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::process::ExitCode;
 use std::sync::Arc;
 
 use clap::Args;
@@ -42,10 +43,19 @@ pub(super) struct RenderArgs {
     /// Longest render in seconds; the render stops earlier once everything is silent.
     #[arg(long, default_value_t = 30.0, value_parser = parse_max_seconds)]
     max_seconds: f64,
+    /// Scale the render so that its peak is this many dBFS (0 or below), e.g. -1: loud chords
+    /// then do not clip.
+    #[arg(long, value_name = "DBFS", allow_hyphen_values = true, value_parser = parse_normalize)]
+    normalize: Option<f32>,
 }
 
-/// `render`: everything is checked before rendering, and nothing is written on failure.
-pub(super) fn run(args: &RenderArgs) -> Result<(), String> {
+/// Exit status of a render that wrote a silent file: not an error, but not what was asked.
+pub(super) const SILENT_EXIT: u8 = 3;
+
+/// `render`: everything is checked before rendering, and nothing is written on failure. A
+/// render that clips is written with a warning; one that is silent is written with a warning
+/// and [`SILENT_EXIT`].
+pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
     let bank = load_bank(&args.bank)?;
     let mut controls = Controls::for_bank(&bank);
     for (name, value) in &args.set {
@@ -89,8 +99,12 @@ pub(super) fn run(args: &RenderArgs) -> Result<(), String> {
 
     let mut progress = Progress::new("rendering");
     let bank = Arc::new(PreparedBank::new(&bank));
-    let rendered = render(&bank, &notes, &settings, |done| progress.set(done));
+    let mut rendered = render(&bank, &notes, &settings, |done| progress.set(done));
     let elapsed = progress.finish();
+    let silent = rendered.peak() < args.bits.least_level();
+    if let Some(peak_dbfs) = args.normalize.filter(|_| !silent) {
+        rendered.normalize(peak_dbfs);
+    }
     if to_stdout {
         let bytes = wav_bytes(&rendered, args.bits, args.rate)
             .map_err(|e| format!("standard output: cannot write WAV: {e}"))?;
@@ -130,7 +144,35 @@ pub(super) fn run(args: &RenderArgs) -> Result<(), String> {
     } else {
         println!("{summary}");
     }
-    Ok(())
+    if clipped {
+        let clips = rendered.clipped_samples();
+        eprintln!(
+            "warning: the render peaks at {peak_dbfs:+.1} dBFS: {clips} sample{} clipped in the \
+             {} file. Render again with --normalize -1 (the peak at -1 dBFS), softer notes, \
+             --set output_gain_db=-6, or --bits 32 to keep the peaks",
+            if clips == 1 { " is" } else { "s are" },
+            args.bits.name()
+        );
+    }
+    if silent {
+        eprintln!(
+            "warning: the render is silent: no sample reaches the {} file's least level. The \
+             notes may be too soft, the bank's gains zero, or its modes above the playable \
+             range at {} Hz",
+            args.bits.name(),
+            args.rate
+        );
+        return Ok(ExitCode::from(SILENT_EXIT));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Parses `--normalize`: a level in dBFS from -100 to 0.
+fn parse_normalize(text: &str) -> Result<f32, String> {
+    text.parse::<f32>()
+        .ok()
+        .filter(|db| (-100.0..=0.0).contains(db))
+        .ok_or_else(|| format!("expected a peak level in dBFS from -100 to 0, found \"{text}\""))
 }
 
 /// Parses `NAME=VALUE` for `--set`.

@@ -38,6 +38,17 @@ impl BitDepth {
         Self::ALL.into_iter().find(|d| d.bits() == bits)
     }
 
+    /// The smallest level a file of this depth holds, as a share of full scale: one step of an
+    /// integer file, -140 dBFS (under 24-bit's step) for float. A render whose peak stays
+    /// below it is silent.
+    pub fn least_level(self) -> f32 {
+        match self {
+            BitDepth::Int16 => 1.0 / 32_768.0,
+            BitDepth::Int24 => 1.0 / 8_388_608.0,
+            BitDepth::Float32 => 1e-7,
+        }
+    }
+
     /// Short description, such as "24-bit" or "32-bit float".
     pub fn name(self) -> &'static str {
         match self {
