@@ -432,6 +432,7 @@ fn help_lists_the_subcommands() {
     }
 }
 
+#[cfg(unix)]
 #[test]
 fn the_standalone_runs_headless_with_the_dummy_backend() {
     // The standalone runs until stopped: start it, let it process for a while, then stop it as
@@ -528,6 +529,33 @@ fn a_clipping_render_warns_and_normalize_sets_the_peak() {
             "--normalize {target}: peak {peak_dbfs:.3} dBFS"
         );
     }
+    // A note near the quietest a 16-bit file holds is lifted before it is written.
+    let out = run(
+        dir.path(),
+        &[
+            "render",
+            "bank.json",
+            "--notes",
+            "69:0.003@0",
+            "--bits",
+            "16",
+            "--normalize",
+            "-6",
+            "-o",
+            "soft.wav",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let mut reader = hound::WavReader::open(dir.path().join("soft.wav")).unwrap();
+    let peak = reader
+        .samples::<i16>()
+        .map(|s| s.unwrap().unsigned_abs())
+        .max()
+        .unwrap();
+    assert!(
+        (20.0 * (peak as f64 / 32_768.0).log10() + 6.0).abs() < 0.05,
+        "soft note normalised to a peak of {peak}"
+    );
     let out = run(dir.path(), &args(&["--normalize", "3", "-o", "bad.wav"]));
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     assert!(stderr(&out).contains("from -100 to 0"), "{}", stderr(&out));

@@ -61,7 +61,8 @@ const CASES: &[Case] = &[
         max_all_db: 3.3,
         max_cents: 8.0,
     },
-    // Sounds still dying away when their files end: their noise is not their quietest frames.
+    // Sounds whose power still falls over their files' last frames: their noise is not their
+    // quietest frames.
     Case {
         slug: "claves-fluid",
         max_all_db: 2.6,

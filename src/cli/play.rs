@@ -5,15 +5,9 @@
 /// automatic choice would fall back to a silent backend with nothing to show or stop it.
 #[cfg(feature = "standalone")]
 pub(super) fn run(args: Vec<String>) -> Result<(), String> {
-    let asks = |names: &[&str]| {
-        args.iter().any(|a| {
-            names
-                .iter()
-                .any(|n| a == n || (n.starts_with("--") && a.starts_with(&format!("{n}="))))
-        })
-    };
-    if !asks(&["-h", "--help", "-V", "--version"]) && !has_display() {
-        if !asks(&["-b", "--backend"]) {
+    let help = args.iter().any(|a| a == "-h" || a == "--help");
+    if !help && !has_display() {
+        if matches!(backend(&args), None | Some("auto")) {
             return Err(
                 "no display to open the instrument's window on (DISPLAY is not set). \
                  To play without a window, name the audio backend: `play --backend jack` or \
@@ -36,6 +30,24 @@ pub(super) fn run(args: Vec<String>) -> Result<(), String> {
                 .to_string(),
         )
     }
+}
+
+/// The backend named in the standalone's options, in any of the spellings its parser takes
+/// (`--backend X`, `--backend=X`, `-b X`, `-bX`, `-b=X`); the last one named counts.
+#[cfg(feature = "standalone")]
+fn backend(args: &[String]) -> Option<&str> {
+    let mut named = None;
+    let mut words = args.iter();
+    while let Some(a) = words.next() {
+        if a == "--backend" || a == "-b" {
+            named = words.next().map(String::as_str);
+        } else if let Some(v) = a.strip_prefix("--backend=") {
+            named = Some(v);
+        } else if let Some(v) = a.strip_prefix("-b").filter(|_| !a.starts_with("--")) {
+            named = Some(v.strip_prefix('=').unwrap_or(v));
+        }
+    }
+    named
 }
 
 /// Whether a window can be opened: on Linux and the BSDs, an X11 display is named.

@@ -101,10 +101,11 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
     let bank = Arc::new(PreparedBank::new(&bank));
     let mut rendered = render(&bank, &notes, &settings, |done| progress.set(done));
     let elapsed = progress.finish();
-    let silent = rendered.peak() < args.bits.least_level();
-    if let Some(peak_dbfs) = args.normalize.filter(|_| !silent) {
+    if let Some(peak_dbfs) = args.normalize {
         rendered.normalize(peak_dbfs);
     }
+    // Under half its least level, a sample is written as zero.
+    let silent = rendered.peak() < 0.5 * args.bits.least_level();
     if to_stdout {
         let bytes = wav_bytes(&rendered, args.bits, args.rate)
             .map_err(|e| format!("standard output: cannot write WAV: {e}"))?;
@@ -156,7 +157,7 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
     }
     if silent {
         eprintln!(
-            "warning: the render is silent: no sample reaches the {} file's least level. The \
+            "warning: the render is silent: every sample rounds to zero in the {} file. The \
              notes may be too soft, the bank's gains zero, or its modes above the playable \
              range at {} Hz",
             args.bits.name(),

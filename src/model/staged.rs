@@ -229,18 +229,23 @@ fn keep_copy(path: &Path) -> io::Result<Option<tempfile::TempPath>> {
         Some(dir) if !dir.as_os_str().is_empty() => dir,
         _ => Path::new("."),
     };
-    let backup = tracked(
+    let mut backup = tracked(
         || {
             tempfile::Builder::new()
                 .prefix(".modal-previous-")
                 .suffix(".tmp")
                 .tempfile_in(dir)
-                .map(NamedTempFile::into_temp_path)
         },
-        |t| t,
+        |t| t.path(),
     )?;
-    std::fs::copy(path, &backup)?;
-    Ok(Some(backup))
+    // Through the file already open, never by its name: a signal that removed it meanwhile
+    // must not see it made again.
+    let mut source = std::fs::File::open(path)?;
+    io::copy(&mut source, backup.as_file_mut())?;
+    backup
+        .as_file()
+        .set_permissions(source.metadata()?.permissions())?;
+    Ok(Some(backup.into_temp_path()))
 }
 
 #[cfg(test)]

@@ -39,8 +39,8 @@ impl BitDepth {
     }
 
     /// The smallest level a file of this depth holds, as a share of full scale: one step of an
-    /// integer file, -140 dBFS (under 24-bit's step) for float. A render whose peak stays
-    /// below it is silent.
+    /// integer file; for float, where far smaller values are held, -140 dBFS (under 24-bit's
+    /// step), taken as silence.
     pub fn least_level(self) -> f32 {
         match self {
             BitDepth::Int16 => 1.0 / 32_768.0,
