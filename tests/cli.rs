@@ -25,6 +25,20 @@ fn stdout(out: &Output) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
+/// The output of `child` once it ends; if it runs on past `seconds`, it is killed and the test
+/// fails with `failure`.
+fn wait_within(mut child: std::process::Child, seconds: u64, failure: &str) -> Output {
+    let started = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if started.elapsed().as_secs() > seconds {
+            let _ = child.kill();
+            panic!("{failure}");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.wait_with_output().unwrap()
+}
+
 /// A temporary directory holding `bank.json`: two quickly decaying modes rooted at 440 Hz.
 fn dir_with_bank() -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
@@ -457,15 +471,11 @@ fn the_standalone_runs_headless_with_the_dummy_backend() {
         let still_running = child.try_wait().unwrap().is_none();
         // SAFETY: sends a signal to the child this test started and has not reaped.
         assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGINT) }, 0);
-        let started = std::time::Instant::now();
-        while child.try_wait().unwrap().is_none() {
-            if started.elapsed().as_secs() > 20 {
-                let _ = child.kill();
-                panic!("{play:?}: Ctrl-C did not stop the standalone");
-            }
-            std::thread::sleep(std::time::Duration::from_millis(20));
-        }
-        let out = child.wait_with_output().unwrap();
+        let out = wait_within(
+            child,
+            20,
+            &format!("{play:?}: Ctrl-C did not stop the standalone"),
+        );
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(
             still_running,
@@ -591,22 +601,18 @@ fn a_silent_render_warns_and_exits_with_its_own_status() {
 #[test]
 fn the_standalone_with_no_display_and_no_backend_named_says_so_and_exits() {
     for play in [&["play"][..], &[]] {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_modal-resonator"))
+        let child = Command::new(env!("CARGO_BIN_EXE_modal-resonator"))
             .args(play)
             .env_remove("DISPLAY")
             .stdout(std::process::Stdio::piped())
             .stderr(std::process::Stdio::piped())
             .spawn()
             .expect("the binary runs");
-        let started = std::time::Instant::now();
-        while child.try_wait().unwrap().is_none() {
-            if started.elapsed().as_secs() > 20 {
-                let _ = child.kill();
-                panic!("{play:?}: the standalone blocked with nothing to play on");
-            }
-            std::thread::sleep(std::time::Duration::from_millis(20));
-        }
-        let out = child.wait_with_output().unwrap();
+        let out = wait_within(
+            child,
+            20,
+            &format!("{play:?}: the standalone blocked with nothing to play on"),
+        );
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{play:?}: {stderr}");
         assert!(

@@ -179,6 +179,16 @@ mod tests {
     use super::*;
     use crate::dsp::rng::Rng;
 
+    /// Analysis window of the tests, in samples, at 48 kHz.
+    const LEN: usize = 2048;
+
+    /// The spectrogram of `x` (48 kHz) and the noise estimated from it.
+    fn estimate(x: &[f64]) -> (Spectrogram, NoiseSpectrum) {
+        let spec = Spectrogram::new(x, 48_000.0, LEN, LEN / 4, 2);
+        let noise = NoiseSpectrum::estimate(&spec, hann(LEN).iter().sum());
+        (spec, noise)
+    }
+
     #[test]
     fn white_noise_power_is_found_under_decaying_and_ringing_modes() {
         let rate = 48_000.0;
@@ -232,11 +242,9 @@ mod tests {
                 sigma * 3f64.sqrt() * rng.bipolar() as f64 + 1e-2 * (-4.0 * t).exp() * ring
             })
             .collect();
-        let len = 2048;
-        let spec = Spectrogram::new(&x, rate, len, len / 4, 2);
-        let w = hann(len);
-        let noise = NoiseSpectrum::estimate(&spec, w.iter().sum());
-        let expected = sigma * sigma * w.iter().map(|v| v * v).sum::<f64>();
+        let (spec, noise) = estimate(&x);
+        // White noise of variance s^2 gives E|X|^2 = s^2 sum(w^2) in every bin.
+        let expected = sigma * sigma * hann(LEN).iter().map(|v| v * v).sum::<f64>();
         for f in [1500.0, 2000.0, 2500.0, 8000.0] {
             let ratio_db = 10.0 * (noise.at(&spec, f) / expected).log10();
             assert!(
@@ -289,12 +297,8 @@ mod tests {
                 }
             })
             .collect();
-        let len = 2048;
-        let w = hann(len);
-        let heard =
-            NoiseSpectrum::estimate(&Spectrogram::new(&x, rate, len, len / 4, 2), w.iter().sum());
-        let spec = Spectrogram::new(&noise_only, rate, len, len / 4, 2);
-        let truth = NoiseSpectrum::estimate(&spec, w.iter().sum());
+        let (_, heard) = estimate(&x);
+        let (spec, truth) = estimate(&noise_only);
         // The percentile over the whole file lies further into the frames before the strike
         // than the same percentile of the noise alone: a few dB above it. Taking the noise from
         // the quieter frequencies around would put it 30 dB below.
