@@ -152,11 +152,11 @@ pub fn dedupe(modes: &mut Vec<BandMode>, sound_s: f64) {
 pub fn fit_band(splitter: &mut Splitter, core: (f64, f64), index: usize) -> Vec<BandMode> {
     let mut band = splitter.band(core, usize::MAX);
     let mut measured = measure(&band);
-    // A band much longer than its sound is made again, cut shorter: the fit's cost grows with
-    // the band's length.
+    // A band longer than its sound is made again, cut shorter: the fit's cost grows with the
+    // band's length.
     if let Some((_, end)) = measured {
         let wanted = (SPARE_LENGTH * (end + band.first) as f64) as usize;
-        if 2 * wanted < band.samples.len() {
+        if wanted + wanted / 4 < band.samples.len() {
             band = splitter.band(core, wanted);
             measured = measure(&band);
         }

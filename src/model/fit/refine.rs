@@ -78,6 +78,9 @@ const RESOLUTION_SHARE: f64 = 0.5;
 /// A mode louder than this many times the band's loudest sample is cancelling another.
 const MAX_OVER_PEAK: f64 = 2.0;
 
+/// Rows of the Jacobian taken at once in its normal equations.
+const ROWS_AT_ONCE: usize = 512;
+
 /// Weight of the parameter count in the description length: 1 is Rissanen's MDL.
 const MDL_PENALTY: f64 = 1.0;
 
@@ -127,6 +130,8 @@ pub struct Target<'a> {
     scratch: RefCell<Vec<Complex64>>,
     /// Work buffers as long as the band's transform.
     work: RefCell<[Vec<Complex64>; 4]>,
+    /// The weighted Jacobian and residual of the last normal equations, kept for the next.
+    jacobian: RefCell<(Vec<f64>, Vec<f64>)>,
 }
 
 impl<'a> Target<'a> {
@@ -174,6 +179,7 @@ impl<'a> Target<'a> {
                 inverse.get_inplace_scratch_len()
             ]),
             work: RefCell::default(),
+            jacobian: RefCell::default(),
             inverse,
             bins,
             lanes: Lanes::new(&twiddles, &band.taper),
@@ -424,8 +430,12 @@ impl<'a> Target<'a> {
         // The weighted Jacobian by columns and the weighted residual, real parts then imaginary
         // parts: `J^T W J` is then the real part of `J^H W J`.
         let m = self.range.len();
-        let mut jacobian = vec![0.0; dim * 2 * m];
-        let mut residual = vec![0.0; 2 * m];
+        let mut buffers = self.jacobian.borrow_mut();
+        let (jacobian, residual) = &mut *buffers;
+        jacobian.clear();
+        jacobian.resize(dim * 2 * m, 0.0);
+        residual.clear();
+        residual.resize(2 * m, 0.0);
         let mut put = |column: usize, i: usize, v: Complex64| {
             jacobian[column * 2 * m + i] = v.re;
             jacobian[column * 2 * m + m + i] = v.im;
@@ -445,14 +455,23 @@ impl<'a> Target<'a> {
             }
             put(dim - 1, i, d_tau[i] * w);
         }
-        let column = |a: usize| &jacobian[a * 2 * m..(a + 1) * 2 * m];
+        // By stretches of rows short enough that every column's stretch stays in the cache
+        // while it meets the others.
         let mut normal = vec![0.0; dim * dim];
         let mut gradient = vec![0.0; dim];
+        for start in (0..2 * m).step_by(ROWS_AT_ONCE) {
+            let rows = start..(start + ROWS_AT_ONCE).min(2 * m);
+            let column = |a: usize| &jacobian[a * 2 * m..(a + 1) * 2 * m][rows.clone()];
+            for a in 0..dim {
+                gradient[a] += dot(column(a), &residual[rows.clone()]);
+                for b in a..dim {
+                    normal[a * dim + b] += dot(column(a), column(b));
+                }
+            }
+        }
         for a in 0..dim {
-            gradient[a] = dot(column(a), &residual);
-            for b in a..dim {
-                normal[a * dim + b] = dot(column(a), column(b));
-                normal[b * dim + a] = normal[a * dim + b];
+            for b in 0..a {
+                normal[a * dim + b] = normal[b * dim + a];
             }
         }
         (normal, gradient)
