@@ -539,6 +539,37 @@ fn unreadable_midi_files_are_named_in_the_error() {
     assert!(err.contains("garbage.mid") && err.contains("MIDI"), "{err}");
 }
 
+/// A file cut short (in a track, between tracks, or in a chunk's header) is refused, not played
+/// in part.
+#[test]
+fn a_midi_file_cut_short_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let whole = dir.path().join("whole.mid");
+    write_two_tempo_file(&whole);
+    assert_eq!(read_midi_file(&whole).unwrap().len(), 3);
+    let bytes = std::fs::read(&whole).unwrap();
+    // The second track's chunk starts after the header (14 bytes) and the first track.
+    let first_track_len = u32::from_be_bytes(bytes[18..22].try_into().unwrap()) as usize;
+    let second = 14 + 8 + first_track_len;
+    for (cut, expected) in [
+        (bytes.len() - 3, "declares"),
+        (second + 12, "declares"),
+        (second + 4, "chunk header"),
+        (second, "2 tracks, 1"),
+    ] {
+        let path = dir.path().join(format!("cut-{cut}.mid"));
+        std::fs::write(&path, &bytes[..cut]).unwrap();
+        let err = read_midi_file(&path).unwrap_err().to_string();
+        assert!(
+            err.contains(&format!("cut-{cut}.mid"))
+                && err.contains("cut short")
+                && err.contains(expected),
+            "cut at {cut} of {}: {err}",
+            bytes.len()
+        );
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // WAV files
 

@@ -30,7 +30,54 @@ pub fn read_midi_file(path: impl AsRef<Path>) -> Result<Vec<Note>, RenderError> 
         path: path.to_path_buf(),
         message: format!("not a readable MIDI file: {e}"),
     })?;
+    check_complete(&bytes).map_err(|message| RenderError::Midi {
+        path: path.to_path_buf(),
+        message,
+    })?;
     Ok(notes_of(&smf))
+}
+
+/// An error unless every chunk a standard MIDI file declares is there whole: the parser reads
+/// what it can of a file cut short, which would play only part of it.
+fn check_complete(bytes: &[u8]) -> Result<(), String> {
+    let length_at = |at: usize| {
+        bytes
+            .get(at..at + 4)
+            .map(|b| u32::from_be_bytes([b[0], b[1], b[2], b[3]]) as usize)
+    };
+    // The header chunk: "MThd", its length, format, number of tracks, timing.
+    let header_len = length_at(4).ok_or("the file is cut short in its header")?;
+    let declared_tracks = bytes
+        .get(10..12)
+        .map(|b| u16::from_be_bytes([b[0], b[1]]) as usize)
+        .ok_or("the file is cut short in its header")?;
+    let mut at = 8 + header_len;
+    let mut tracks = 0;
+    while at < bytes.len() {
+        let Some(len) = length_at(at + 4) else {
+            return Err(format!(
+                "the file is cut short: {} bytes at byte {at} where a chunk header of 8 is due",
+                bytes.len() - at
+            ));
+        };
+        let end = at + 8 + len;
+        if end > bytes.len() {
+            return Err(format!(
+                "the file is cut short: the chunk at byte {at} declares {len} bytes, {} are there",
+                bytes.len() - at - 8
+            ));
+        }
+        if &bytes[at..at + 4] == b"MTrk" {
+            tracks += 1;
+        }
+        at = end;
+    }
+    if tracks < declared_tracks {
+        return Err(format!(
+            "the file is cut short: its header declares {declared_tracks} tracks, {tracks} are there"
+        ));
+    }
+    Ok(())
 }
 
 /// A note or tempo event at an absolute tick.
