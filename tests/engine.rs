@@ -90,6 +90,33 @@ fn a_strike_peaks_near_minus_6_dbfs_at_every_rate() {
     }
 }
 
+/// The lowest mode frequency a bank may hold still keeps a strike's level: a mode at 1 Hz that
+/// never decays has peaked by the time the bank's level is measured, and a long render stays
+/// within 1 dB of -6 dBFS; a slower one is refused.
+#[test]
+fn the_lowest_mode_a_bank_may_hold_keeps_the_strike_level() {
+    use modal_resonator::model::validate::validate_bank;
+    let mut bank = simple_bank(&[(1.0, 0.0, 1.0), (220.0, 2.0, 0.3)]);
+    bank.root_hz = Some(220.0);
+    let problems = validate_bank(&bank);
+    assert!(problems.is_empty(), "a mode at 1 Hz is valid: {problems:?}");
+    let mut e = engine(&bank, RATE);
+    let (l, r) = render(&mut e, &[on(0, 57, 1.0)], 3.0, 512);
+    let peak_db = gain_to_db(peak(&l).max(peak(&r)));
+    assert!(
+        (peak_db - gain_to_db(TARGET_PEAK)).abs() <= 1.0,
+        "peak {peak_db} dBFS over 3 s, expected about -6"
+    );
+    bank.modes[0].freq_hz = 0.001;
+    let problems: Vec<String> = validate_bank(&bank).iter().map(|p| p.to_string()).collect();
+    assert!(
+        problems.len() == 1
+            && problems[0].contains("modes[0].freq_hz")
+            && problems[0].contains("from 1 to"),
+        "{problems:?}"
+    );
+}
+
 #[test]
 fn truncation_ends_modes_at_the_threshold_and_frees_the_voice() {
     let decay = t60_to_decay(0.5);

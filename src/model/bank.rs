@@ -71,8 +71,8 @@ pub struct Position {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Mode {
-    /// Frequency in Hz at size 1.
-    #[schemars(extend("exclusiveMinimum" = 0, "maximum" = 1_000_000))]
+    /// Frequency in Hz at size 1, from 1 Hz.
+    #[schemars(extend("minimum" = 1, "maximum" = 1_000_000))]
     pub freq_hz: f64,
     /// Exponential decay rate of the amplitude in 1/s (T60 = 3 ln 10 / decay).
     #[schemars(range(min = 0, max = 1_000_000))]

@@ -82,6 +82,11 @@ pub const FREQ_HZ: NumberRange = NumberRange {
     unit: " Hz",
 };
 
+/// Mode frequency: from 1 Hz, where a default strike (measured over its first second to set
+/// the bank's level) has reached its peak; below it a mode is a slow swell of near DC that a
+/// level set at the strike cannot bound. 1 MHz as for [`FREQ_HZ`].
+pub const MODE_FREQ_HZ: NumberRange = NumberRange::closed(1.0, 1e6, " Hz");
+
 /// Mode decay rate: 0 rings forever; 1e6 per second dies within a sample at any audio rate.
 pub const DECAY_PER_S: NumberRange = NumberRange::closed(0.0, 1e6, " per second");
 
@@ -169,7 +174,10 @@ pub(crate) fn check_bank(bank: &Bank, problems: &mut Problems) {
     );
     for (i, mode) in bank.modes.iter().enumerate() {
         let path = modes_path.index(i);
-        problems.check(&path.field("freq_hz"), check_number(mode.freq_hz, &FREQ_HZ));
+        problems.check(
+            &path.field("freq_hz"),
+            check_number(mode.freq_hz, &MODE_FREQ_HZ),
+        );
         problems.check(
             &path.field("decay_per_s"),
             check_number(mode.decay_per_s, &DECAY_PER_S),

@@ -9,7 +9,7 @@ use serde_json::{Map, Value};
 use super::{
     check_count, check_format, check_gains_len, check_name, check_number, check_version, quote,
     JsonPath, NumberRange, Problems, SameDimension, UniqueNames, COORD, DECAY_PER_S,
-    DEFAULTS_RANGES, FREQ_HZ, GAIN, MAX_MODES, MAX_POSITIONS,
+    DEFAULTS_RANGES, FREQ_HZ, GAIN, MAX_MODES, MAX_POSITIONS, MODE_FREQ_HZ,
 };
 use crate::model::bank::FORMAT_VERSION;
 
@@ -169,7 +169,7 @@ fn check_modes(
             mode,
             &path,
             "freq_hz",
-            &FREQ_HZ,
+            &MODE_FREQ_HZ,
             Presence::Required,
             problems,
         );
