@@ -540,7 +540,8 @@ fn unreadable_midi_files_are_named_in_the_error() {
 }
 
 /// A file cut short (in a track, between tracks, or in a chunk's header) is refused, not played
-/// in part.
+/// in part; a whole one with a few bytes of junk after its tracks, or wrapped in RIFF (RMID),
+/// plays.
 #[test]
 fn a_midi_file_cut_short_is_refused() {
     let dir = tempfile::tempdir().unwrap();
@@ -548,6 +549,21 @@ fn a_midi_file_cut_short_is_refused() {
     write_two_tempo_file(&whole);
     assert_eq!(read_midi_file(&whole).unwrap().len(), 3);
     let bytes = std::fs::read(&whole).unwrap();
+    let padded = dir.path().join("padded.mid");
+    std::fs::write(&padded, [&bytes[..], &[0, 0, 0]].concat()).unwrap();
+    assert_eq!(read_midi_file(&padded).unwrap().len(), 3);
+    let mut riff = b"RIFF".to_vec();
+    riff.extend_from_slice(&(4 + 8 + bytes.len() as u32).to_le_bytes());
+    riff.extend_from_slice(b"RMIDdata");
+    riff.extend_from_slice(&(bytes.len() as u32).to_le_bytes());
+    riff.extend_from_slice(&bytes);
+    let rmid = dir.path().join("wrapped.rmi");
+    std::fs::write(&rmid, &riff).unwrap();
+    assert_eq!(read_midi_file(&rmid).unwrap().len(), 3);
+    let cut_rmid = dir.path().join("cut-wrapped.rmi");
+    std::fs::write(&cut_rmid, &riff[..riff.len() - 3]).unwrap();
+    let err = read_midi_file(&cut_rmid).unwrap_err().to_string();
+    assert!(err.contains("cut short"), "{err}");
     // The second track's chunk starts after the header (14 bytes) and the first track.
     let first_track_len = u32::from_be_bytes(bytes[18..22].try_into().unwrap()) as usize;
     let second = 14 + 8 + first_track_len;

@@ -26,7 +26,7 @@ pub(super) struct FitArgs {
     /// resynthesis, and the strongest by energy of those when there are more.
     #[arg(long, default_value_t = DEFAULT_MAX_MODES)]
     modes: usize,
-    /// Lowest mode frequency searched, in Hz.
+    /// Lowest mode frequency searched, in Hz (at least 1, the lowest a bank may hold).
     #[arg(long, default_value_t = 20.0)]
     min_hz: f64,
     /// Highest mode frequency searched, in Hz (never above 0.45 times the sample rate).

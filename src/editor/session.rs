@@ -12,8 +12,8 @@ use crate::model::Bank;
 /// first. 8 M values is 64 MB: hundreds of steps of a large bank.
 const UNDO_BUDGET_VALUES: usize = 8_000_000;
 
-/// Lowest frequency an edit sets, in Hz (the format only asks for more than 0).
-const MIN_EDIT_FREQ_HZ: f64 = 1.0;
+/// Lowest frequency an edit sets, in Hz: the lowest the format allows.
+const MIN_EDIT_FREQ_HZ: f64 = crate::model::validate::MODE_FREQ_HZ.min;
 
 /// The state one undo step restores.
 #[derive(Debug, Clone, PartialEq)]

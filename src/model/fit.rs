@@ -149,9 +149,10 @@ impl FitOptions {
                 crate::model::validate::MAX_MODES
             ));
         }
-        if !(self.min_hz.is_finite() && self.min_hz > 0.0 && self.max_hz > self.min_hz) {
+        let lowest = crate::model::validate::MODE_FREQ_HZ.min;
+        if !(self.min_hz.is_finite() && self.min_hz >= lowest && self.max_hz > self.min_hz) {
             return bad(format!(
-                "frequency range {} Hz to {} Hz: expected 0 < --min-hz < --max-hz",
+                "frequency range {} Hz to {} Hz: expected {lowest} <= --min-hz < --max-hz",
                 self.min_hz, self.max_hz
             ));
         }

@@ -73,7 +73,7 @@ impl NumberRange {
     }
 }
 
-/// Mode frequency and root pitch: positive, and 1 MHz is far above any sample rate's Nyquist
+/// Root pitch (and the top of a mode's frequency): positive, and 1 MHz is far above any sample rate's Nyquist
 /// frequency (such modes are dropped when rendering) while keeping `2 pi f` far from overflow.
 pub const FREQ_HZ: NumberRange = NumberRange {
     min: 0.0,

@@ -37,47 +37,70 @@ pub fn read_midi_file(path: impl AsRef<Path>) -> Result<Vec<Note>, RenderError> 
     Ok(notes_of(&smf))
 }
 
-/// An error unless every chunk a standard MIDI file declares is there whole: the parser reads
-/// what it can of a file cut short, which would play only part of it.
+/// An error unless every track a standard MIDI file declares is there whole: the parser reads
+/// what it can of a file cut short, which would play only part of it. A RIFF-wrapped file
+/// (RMID) is checked inside its `data` chunk; bytes after the last track declared are left to
+/// the parser, as junk at the end of a whole file is.
 fn check_complete(bytes: &[u8]) -> Result<(), String> {
+    let bytes = riff_data(bytes)?;
     let length_at = |at: usize| {
         bytes
-            .get(at..at + 4)
+            .get(at..at.checked_add(4)?)
             .map(|b| u32::from_be_bytes([b[0], b[1], b[2], b[3]]) as usize)
     };
     // The header chunk: "MThd", its length, format, number of tracks, timing.
-    let header_len = length_at(4).ok_or("the file is cut short in its header")?;
+    let cut_in_header = || "the file is cut short in its header".to_string();
+    let header_len = length_at(4).ok_or_else(cut_in_header)?;
     let declared_tracks = bytes
         .get(10..12)
         .map(|b| u16::from_be_bytes([b[0], b[1]]) as usize)
-        .ok_or("the file is cut short in its header")?;
-    let mut at = 8 + header_len;
+        .ok_or_else(cut_in_header)?;
+    let mut at = header_len.checked_add(8).ok_or_else(cut_in_header)?;
     let mut tracks = 0;
-    while at < bytes.len() {
+    while tracks < declared_tracks {
+        if at >= bytes.len() {
+            return Err(format!(
+                "the file is cut short: its header declares {declared_tracks} tracks, {tracks} are there"
+            ));
+        }
         let Some(len) = length_at(at + 4) else {
             return Err(format!(
                 "the file is cut short: {} bytes at byte {at} where a chunk header of 8 is due",
                 bytes.len() - at
             ));
         };
-        let end = at + 8 + len;
-        if end > bytes.len() {
+        let there = bytes.len() - at - 8;
+        if len > there {
             return Err(format!(
-                "the file is cut short: the chunk at byte {at} declares {len} bytes, {} are there",
-                bytes.len() - at - 8
+                "the file is cut short: the chunk at byte {at} declares {len} bytes, {there} are there"
             ));
         }
         if &bytes[at..at + 4] == b"MTrk" {
             tracks += 1;
         }
-        at = end;
-    }
-    if tracks < declared_tracks {
-        return Err(format!(
-            "the file is cut short: its header declares {declared_tracks} tracks, {tracks} are there"
-        ));
+        at += 8 + len;
     }
     Ok(())
+}
+
+/// The standard MIDI file inside a RIFF-wrapped one (its `data` chunk), or `bytes` themselves.
+fn riff_data(bytes: &[u8]) -> Result<&[u8], String> {
+    if !bytes.starts_with(b"RIFF") {
+        return Ok(bytes);
+    }
+    let mut at = 12;
+    while let Some(header) = bytes.get(at..at + 8) {
+        let len = u32::from_le_bytes([header[4], header[5], header[6], header[7]]) as usize;
+        let body = &bytes[at + 8..];
+        if &header[..4] == b"data" {
+            return Ok(&body[..len.min(body.len())]);
+        }
+        match (at + 8).checked_add(len + (len & 1)) {
+            Some(next) => at = next,
+            None => break,
+        }
+    }
+    Err("the file is cut short: a RIFF file without its data chunk".to_string())
 }
 
 /// A note or tempo event at an absolute tick.

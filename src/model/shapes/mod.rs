@@ -161,7 +161,8 @@ pub(crate) fn finish_modes(
     material: &Material,
     limits: &ModeLimits,
 ) -> Result<Vec<Mode>, ShapeError> {
-    shaped.retain(|mode| mode.freq_hz > 0.0 && mode.freq_hz < limits.max_freq_hz);
+    let min_hz = crate::model::validate::MODE_FREQ_HZ.min;
+    shaped.retain(|mode| mode.freq_hz >= min_hz && mode.freq_hz < limits.max_freq_hz);
     shaped.sort_by(|a, b| a.freq_hz.total_cmp(&b.freq_hz));
     shaped.truncate(limits.max_modes);
     if shaped.is_empty() {
