@@ -73,8 +73,9 @@ impl NumberRange {
     }
 }
 
-/// Root pitch (and the top of a mode's frequency): positive, and 1 MHz is far above any sample rate's Nyquist
-/// frequency (such modes are dropped when rendering) while keeping `2 pi f` far from overflow.
+/// Root pitch (and the top of a mode's frequency): positive, and 1 MHz is far above any sample
+/// rate's Nyquist frequency (such modes are dropped when rendering) while keeping `2 pi f` far
+/// from overflow.
 pub const FREQ_HZ: NumberRange = NumberRange {
     min: 0.0,
     min_inclusive: false,
@@ -84,7 +85,8 @@ pub const FREQ_HZ: NumberRange = NumberRange {
 
 /// Mode frequency: from 1 Hz, where a default strike (measured over its first second to set
 /// the bank's level) has reached its peak; below it a mode is a slow swell of near DC that a
-/// level set at the strike cannot bound. 1 MHz as for [`FREQ_HZ`].
+/// level set at the strike cannot bound. The floor is at the bank's own pitch: keys far below
+/// its root play a 1 Hz mode lower still. 1 MHz as for [`FREQ_HZ`].
 pub const MODE_FREQ_HZ: NumberRange = NumberRange::closed(1.0, 1e6, " Hz");
 
 /// Mode decay rate: 0 rings forever; 1e6 per second dies within a sample at any audio rate.
