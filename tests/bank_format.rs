@@ -12,6 +12,7 @@ use modal_resonator::model::schema::bank_schema_json;
 use modal_resonator::model::validate::{validate_bank, MAX_REPORTED_PROBLEMS};
 use modal_resonator::model::{
     load_bank_file, parse_bank_str, save_bank_file, Bank, BankDefaults, BankError, Mode, Position,
+    MAX_BANK_FILE_BYTES, MAX_JSON_VALUES,
 };
 use serde_json::{json, Value};
 
@@ -398,12 +399,12 @@ fn no_modes() {
 
 #[test]
 fn too_many_modes() {
-    let error = parse_bad(&generated_bank(1, 65_537).to_string());
-    assert_only_problem(
-        &error,
-        "modes",
-        "found 65537 modes, expected from 1 to 65536",
-    );
+    // The parser stops at the first mode too many, with where it is.
+    let text = generated_bank(1, 65_537)
+        .to_string()
+        .replace("},{", "},\n{");
+    let error = parse_bad(&text);
+    assert_syntax_error(&error, 65_537, "more than 65536 modes");
     parse_bank_str(&generated_bank(1, 65_536).to_string(), "max.json")
         .unwrap_or_else(|error| panic!("{error}"));
 }
@@ -598,6 +599,82 @@ fn display_names_the_file_then_the_path_or_position() {
         "{error}"
     );
     assert!(std::error::Error::source(&error).is_some());
+}
+
+#[test]
+fn a_file_larger_than_any_bank_is_refused_before_it_is_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("huge.json");
+    // Sparse: the size is what counts, and none of it is read.
+    let file = fs::File::create(&path).unwrap();
+    file.set_len(MAX_BANK_FILE_BYTES + 1).unwrap();
+    let error = load_bank_file(&path).unwrap_err();
+    assert_eq!(error.kind(), BankErrorKind::Io, "{error}");
+    let expected = format!(
+        "huge.json: cannot read: the file holds {} bytes, and a bank file is at most {} bytes",
+        MAX_BANK_FILE_BYTES + 1,
+        MAX_BANK_FILE_BYTES
+    );
+    assert!(error.to_string().contains(&expected), "{error}");
+
+    // A file of the limit itself is read and parsed: here, a syntax error on its first byte.
+    file.set_len(MAX_BANK_FILE_BYTES).unwrap();
+    let error = load_bank_file(&path).unwrap_err();
+    assert!(
+        matches!(error.kind(), BankErrorKind::Syntax { .. }),
+        "{error}"
+    );
+}
+
+#[test]
+fn a_document_of_more_values_than_any_bank_is_refused_while_parsing() {
+    // Any JSON value counts: here a free-form `source` far larger than a whole bank.
+    let mut bank = generated_bank(1, 2);
+    let junk = format!("[{}0]", "0,\n".repeat(2 * MAX_JSON_VALUES));
+    bank["source"] = json!({"kind": "junk", "data": "JUNK"});
+    let text = serde_json::to_string_pretty(&bank)
+        .unwrap()
+        .replace("\"JUNK\"", &junk);
+    let error = parse_bad(&text);
+    let line = match error.kind() {
+        BankErrorKind::Syntax { line, .. } => line,
+        kind => panic!("expected a syntax error, got {kind:?}: {error}"),
+    };
+    assert!(
+        error
+            .to_string()
+            .contains(&format!("more than {MAX_JSON_VALUES} values")),
+        "{error}"
+    );
+    // It stops where the budget runs out (one value a line), not at the end of the document.
+    assert!(line < MAX_JSON_VALUES + 100, "{error}");
+}
+
+#[test]
+fn the_largest_bank_fits_both_limits() {
+    // 65,536 modes at 64 positions, every number as long as this program writes any.
+    let positions = (0..64)
+        .map(|i| Position {
+            name: format!("position {i}"),
+            coords: vec![-1.2345678901234567e-100, 1.2345678901234567e-100],
+        })
+        .collect();
+    let mut bank = Bank::new("Largest", positions);
+    bank.modes = (0..65_536)
+        .map(|i| Mode {
+            freq_hz: 123_456.789_012_345_67 + i as f64 * 1e-9,
+            decay_per_s: 1.234_567_890_123_456_7e-100,
+            gains: vec![-1.234_567_890_123_456_7e-100; 64],
+        })
+        .collect();
+    let text = bank_to_json(&bank);
+    println!(
+        "the largest bank: {} bytes of JSON, limit {MAX_BANK_FILE_BYTES}",
+        text.len()
+    );
+    assert!((text.len() as u64) < MAX_BANK_FILE_BYTES);
+    let loaded = parse_bank_str(&text, "largest.json").unwrap_or_else(|error| panic!("{error}"));
+    assert_eq!(loaded.modes.len(), 65_536);
 }
 
 #[test]

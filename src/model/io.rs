@@ -5,9 +5,10 @@
 //! -> the typed [`Bank`], only when there are none. Saving validates first and replaces the file
 //! atomically.
 
+use std::cell::Cell;
 use std::fmt;
 use std::fs;
-use std::io;
+use std::io::{self, Read};
 use std::path::Path;
 
 use serde::de::{self, DeserializeSeed, MapAccess, SeqAccess, Visitor};
@@ -16,7 +17,7 @@ use serde_json::{Map, Value};
 
 use super::bank::Bank;
 use super::staged::StagedFile;
-use super::validate::{self, Problem, Problems, MAX_REPORTED_PROBLEMS};
+use super::validate::{self, Problem, Problems, MAX_MODES, MAX_POSITIONS, MAX_REPORTED_PROBLEMS};
 
 /// Why a bank could not be loaded or saved. `Display` prints one line per problem, each starting
 /// with the file: `FILE: PATH: message`, or `FILE:LINE:COLUMN: message` for a syntax error.
@@ -173,7 +174,7 @@ pub fn parse_bank_str(text: &str, origin: &str) -> Result<Bank, BankError> {
 /// Reads, parses and validates the bank file at `path`.
 pub fn load_bank_file(path: &Path) -> Result<Bank, BankError> {
     let origin = path.display().to_string();
-    let bytes = fs::read(path).map_err(|error| BankError::io(&origin, "cannot read", error))?;
+    let bytes = read_limited(path).map_err(|error| BankError::io(&origin, "cannot read", error))?;
     match String::from_utf8(bytes) {
         Ok(text) => parse_bank_str(&text, &origin),
         Err(error) => {
@@ -184,6 +185,34 @@ pub fn load_bank_file(path: &Path) -> Result<Bank, BankError> {
             Err(BankError::syntax(&origin, line, column, message))
         }
     }
+}
+
+/// The bytes of the file at `path`, or an error of kind [`io::ErrorKind::FileTooLarge`] naming
+/// the limit when it holds more than [`MAX_BANK_FILE_BYTES`] (checked before reading, and while
+/// reading for files whose size is not known in advance, such as pipes).
+fn read_limited(path: &Path) -> io::Result<Vec<u8>> {
+    let too_large = |size: Option<u64>| {
+        let found = match size {
+            Some(size) => format!("the file holds {size} bytes"),
+            None => format!("the file holds more than {MAX_BANK_FILE_BYTES} bytes"),
+        };
+        let message = format!(
+            "{found}, and a bank file is at most {MAX_BANK_FILE_BYTES} bytes (256 MiB; the \
+             largest bank, {MAX_MODES} modes at {MAX_POSITIONS} positions, takes about 150 MB)"
+        );
+        io::Error::new(io::ErrorKind::FileTooLarge, message)
+    };
+    let file = fs::File::open(path)?;
+    let size = file.metadata()?.len();
+    if size > MAX_BANK_FILE_BYTES {
+        return Err(too_large(Some(size)));
+    }
+    let mut bytes = Vec::with_capacity(usize::try_from(size).unwrap_or(0));
+    file.take(MAX_BANK_FILE_BYTES + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MAX_BANK_FILE_BYTES {
+        return Err(too_large(None));
+    }
+    Ok(bytes)
 }
 
 /// Validates `bank` and writes it to `path` as [`bank_to_json`] does. The file is replaced
@@ -222,16 +251,70 @@ pub fn bank_to_json(bank: &Bank) -> String {
 /// silently resolve to the last one.
 fn parse_json(text: &str) -> Result<Value, serde_json::Error> {
     let mut deserializer = serde_json::Deserializer::from_str(text);
-    let value = StrictValue.deserialize(&mut deserializer)?;
+    let budget = Cell::new(MAX_JSON_VALUES);
+    let value = StrictValue::document(&budget).deserialize(&mut deserializer)?;
     deserializer.end()?;
     Ok(value)
 }
 
-/// Builds a `serde_json::Value` like its own `Deserialize`, but fails on a duplicate key; the
-/// deserializer adds the line and column.
-struct StrictValue;
+/// Largest bank file read: well above the largest bank the format allows as this program writes
+/// it ([`MAX_MODES`] modes of [`MAX_POSITIONS`] full-precision gains, about 150 MB), so that a file
+/// far too large for any bank is refused before it is read.
+pub const MAX_BANK_FILE_BYTES: u64 = 256 << 20;
 
-impl<'de> DeserializeSeed<'de> for StrictValue {
+/// Most JSON values (numbers, strings, arrays, objects...) a bank document may hold: every mode of
+/// the largest bank with room for a few more fields each, plus as many again as one mode count for
+/// names and a free-form `source`. Parsing stops at the first value beyond, so a document far
+/// larger than any bank never grows into a tree many times its size.
+pub const MAX_JSON_VALUES: usize = MAX_MODES * (MAX_POSITIONS + 8) + MAX_MODES;
+
+/// Builds a `serde_json::Value` like its own `Deserialize`, but fails on a duplicate key, on a
+/// `modes` array longer than [`MAX_MODES`] and on a document of more than [`MAX_JSON_VALUES`]
+/// values; the deserializer adds the line and column.
+#[derive(Clone, Copy)]
+struct StrictValue<'a> {
+    /// Values that may still be read in the whole document.
+    budget: &'a Cell<usize>,
+    /// Whether this value is the top-level `modes` field.
+    is_modes: bool,
+    /// Objects around this value: 0 for the document itself.
+    depth: usize,
+}
+
+impl<'a> StrictValue<'a> {
+    fn document(budget: &'a Cell<usize>) -> Self {
+        Self {
+            budget,
+            is_modes: false,
+            depth: 0,
+        }
+    }
+
+    /// A value inside this one (an array element, or the field `key` of an object).
+    fn child(self, key: Option<&str>) -> Self {
+        Self {
+            budget: self.budget,
+            is_modes: self.depth == 0 && key == Some("modes"),
+            depth: self.depth + 1,
+        }
+    }
+
+    /// Counts one value against the document's budget.
+    fn spend<E: de::Error>(self) -> Result<(), E> {
+        match self.budget.get().checked_sub(1) {
+            Some(left) => {
+                self.budget.set(left);
+                Ok(())
+            }
+            None => Err(E::custom(format!(
+                "the document holds more than {MAX_JSON_VALUES} values, far more than a bank of \
+                 {MAX_MODES} modes at {MAX_POSITIONS} positions; the rest was not read"
+            ))),
+        }
+    }
+}
+
+impl<'de> DeserializeSeed<'de> for StrictValue<'_> {
     type Value = Value;
 
     fn deserialize<D: de::Deserializer<'de>>(self, deserializer: D) -> Result<Value, D::Error> {
@@ -239,52 +322,66 @@ impl<'de> DeserializeSeed<'de> for StrictValue {
     }
 }
 
-impl<'de> Visitor<'de> for StrictValue {
+impl<'de> Visitor<'de> for StrictValue<'_> {
     type Value = Value;
 
     fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str("any JSON value")
     }
 
-    fn visit_bool<E>(self, b: bool) -> Result<Value, E> {
+    fn visit_bool<E: de::Error>(self, b: bool) -> Result<Value, E> {
+        self.spend()?;
         Ok(Value::Bool(b))
     }
 
-    fn visit_i64<E>(self, n: i64) -> Result<Value, E> {
+    fn visit_i64<E: de::Error>(self, n: i64) -> Result<Value, E> {
+        self.spend()?;
         Ok(Value::from(n))
     }
 
-    fn visit_u64<E>(self, n: u64) -> Result<Value, E> {
+    fn visit_u64<E: de::Error>(self, n: u64) -> Result<Value, E> {
+        self.spend()?;
         Ok(Value::from(n))
     }
 
-    fn visit_f64<E>(self, x: f64) -> Result<Value, E> {
+    fn visit_f64<E: de::Error>(self, x: f64) -> Result<Value, E> {
+        self.spend()?;
         // The parser yields finite numbers only (it rejects overflow); Value::from maps any
         // other to null, which validation rejects.
         Ok(Value::from(x))
     }
 
-    fn visit_str<E>(self, text: &str) -> Result<Value, E> {
+    fn visit_str<E: de::Error>(self, text: &str) -> Result<Value, E> {
+        self.spend()?;
         Ok(Value::String(text.to_string()))
     }
 
-    fn visit_string<E>(self, text: String) -> Result<Value, E> {
+    fn visit_string<E: de::Error>(self, text: String) -> Result<Value, E> {
+        self.spend()?;
         Ok(Value::String(text))
     }
 
-    fn visit_unit<E>(self) -> Result<Value, E> {
+    fn visit_unit<E: de::Error>(self) -> Result<Value, E> {
+        self.spend()?;
         Ok(Value::Null)
     }
 
     fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Value, A::Error> {
+        self.spend()?;
         let mut values = Vec::new();
-        while let Some(value) = seq.next_element_seed(StrictValue)? {
+        while let Some(value) = seq.next_element_seed(self.child(None))? {
+            if self.is_modes && values.len() == MAX_MODES {
+                return Err(de::Error::custom(format!(
+                    "more than {MAX_MODES} modes, the most a bank may have; the rest was not read"
+                )));
+            }
             values.push(value);
         }
         Ok(Value::Array(values))
     }
 
     fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Value, A::Error> {
+        self.spend()?;
         let mut object = Map::new();
         while let Some(key) = map.next_key::<String>()? {
             if object.contains_key(&key) {
@@ -293,7 +390,7 @@ impl<'de> Visitor<'de> for StrictValue {
                     Value::from(key)
                 )));
             }
-            let value = map.next_value_seed(StrictValue)?;
+            let value = map.next_value_seed(self.child(Some(&key)))?;
             object.insert(key, value);
         }
         Ok(Value::Object(object))
@@ -318,6 +415,10 @@ fn describe_syntax_error(text: &str, error: &serde_json::Error) -> String {
             None => "the document",
         };
         return format!("the text ends in the middle of {inside}: the file looks truncated");
+    }
+    if error.classify() == serde_json::error::Category::Data {
+        // A message of the strict parser's own, already in words.
+        return raw.to_string();
     }
     let lower = token.to_ascii_lowercase();
     let unsigned = lower.trim_start_matches(['-', '+']);

@@ -18,6 +18,7 @@ pub mod validate;
 pub use bank::{Bank, BankDefaults, Mode, Position};
 pub use io::{
     load_bank_file, parse_bank_str, save_bank_file, stage_bank_file, BankError, BankErrorKind,
+    MAX_BANK_FILE_BYTES, MAX_JSON_VALUES,
 };
 pub use staged::{commit_all, StagedFile};
 pub use validate::Problem;
