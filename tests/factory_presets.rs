@@ -121,3 +121,50 @@ fn every_factory_bank_validates_and_plays_near_minus_6_dbfs_at_its_root() {
     }
     println!("{}", report.join("\n"));
 }
+
+/// Most a single note of a factory bank may lean to one side at the default width, in dB of
+/// left-to-right energy over its first two seconds and over its first half second.
+const BALANCE_TOLERANCE_DB: f64 = 1.0;
+
+#[test]
+fn every_factory_bank_sounds_centred_at_the_default_width() {
+    use modal_resonator::dsp::coeffs::hz_to_midi_key;
+
+    let rate = 48_000.0;
+    let energy = |x: &[f32]| x.iter().map(|&v| v as f64 * v as f64).sum::<f64>();
+    let mut report = Vec::new();
+    let mut worst = (0.0f64, String::new());
+    for bank in &factory_banks() {
+        let what = &bank.name;
+        let key = hz_to_midi_key(bank.effective_root_hz()).round() as u8;
+        let mut e = common::engine(bank, rate);
+        let (l, r) = common::render(&mut e, &[common::on(0, key, 1.0)], 2.0, 512);
+        let lean_db = 10.0 * (energy(&r) / energy(&l)).log10();
+        // And over its first half second, where the strike is.
+        let onset_db = 10.0 * (energy(&r[..24_000]) / energy(&l[..24_000])).log10();
+        // The same bank at full width, for the report.
+        let mut e = common::engine(bank, rate);
+        let mut controls = e.controls().clone();
+        controls.width = 1.0;
+        e.set_controls(&controls);
+        let (l_full, r_full) = common::render(&mut e, &[common::on(0, key, 1.0)], 2.0, 512);
+        let full_db = 10.0 * (energy(&r_full) / energy(&l_full)).log10();
+        report.push(format!(
+            "{what}: {lean_db:+.2} dB to the right at the default width ({onset_db:+.2} dB over \
+             the first 0.5 s), {full_db:+.2} dB at full width"
+        ));
+        for lean in [lean_db, onset_db] {
+            if lean.abs() > worst.0 {
+                worst = (lean.abs(), what.clone());
+            }
+        }
+    }
+    println!("{}", report.join("\n"));
+    assert!(
+        worst.0 <= BALANCE_TOLERANCE_DB,
+        "{} leans {:.2} dB to one side, expected at most {BALANCE_TOLERANCE_DB}:\n{}",
+        worst.1,
+        worst.0,
+        report.join("\n")
+    );
+}

@@ -5,7 +5,7 @@ use std::f64::consts::TAU;
 
 use super::controls::Controls;
 use super::position::{PositionMap, PositionWeights};
-use super::stereo::lane_weights;
+use super::stereo::{balanced_pans, lane_weights, COLUMN_PAN};
 use crate::dsp::coeffs::{hz_to_midi_key, ModeCoeffs, MIN_DECAY_PER_S};
 use crate::dsp::{Exciter, Kernel, ResonatorBank, COLUMNS};
 use crate::model::Bank;
@@ -16,6 +16,15 @@ pub const TARGET_PEAK: f32 = 0.5;
 
 /// Sample rate of the loudness measurement; level does not depend on the rate.
 const MEASURE_RATE_HZ: f64 = 48_000.0;
+
+/// Length of a default strike over which the columns' pans are chosen to balance it: the
+/// part of a note a listener places it by.
+const BALANCE_S: f64 = 2.0;
+
+/// Most mode-samples spent measuring the balance (about a tenth of a second of work): a bank
+/// of thousands of modes is measured over less than [`BALANCE_S`], and is balanced by its
+/// density anyway.
+const BALANCE_MODE_SAMPLES: f64 = 1e8;
 
 /// A bank prepared for playing. Built off the audio thread; shared read-only by voices.
 #[derive(Debug, Clone)]
@@ -45,6 +54,9 @@ pub struct PreparedBank {
     pub reference_q: f64,
     /// Gain applied to the bank's gains so a default strike peaks at `TARGET_PEAK`.
     pub normalization: f32,
+    /// Pan of each accumulator column at full width: the default spread dealt so that a default
+    /// strike sounds centred.
+    pub column_pan: [f32; COLUMNS],
 }
 
 impl PreparedBank {
@@ -81,8 +93,19 @@ impl PreparedBank {
             root_key: hz_to_midi_key(bank.effective_root_hz()).round(),
             reference_q,
             normalization: 1.0,
+            column_pan: COLUMN_PAN,
         };
-        let peak = prepared.measure_default_peak();
+        let (frames, peak_len) = prepared.render_default_strike();
+        let mut cov = [[0.0f64; COLUMNS]; COLUMNS];
+        for frame in &frames {
+            for (row, &x) in cov.iter_mut().zip(frame) {
+                for (c, &y) in row.iter_mut().zip(frame) {
+                    *c += x as f64 * y as f64;
+                }
+            }
+        }
+        prepared.column_pan = balanced_pans(&cov);
+        let peak = prepared.default_peak(&frames[..peak_len]);
         if peak > 0.0 && peak.is_finite() {
             prepared.normalization = TARGET_PEAK / peak;
             for g in &mut prepared.gains {
@@ -151,9 +174,12 @@ impl PreparedBank {
             .max(MIN_DECAY_PER_S)
     }
 
-    /// Peak of a full-velocity strike at the first position with the bank's other default
-    /// controls (material, exciter, hardness, width) at the root pitch, before normalisation.
-    fn measure_default_peak(&self) -> f32 {
+    /// Each column's output of a full-velocity strike at the first position with the bank's
+    /// other default controls (material, exciter, hardness) at the root pitch, before
+    /// normalisation, at `MEASURE_RATE_HZ`: `BALANCE_S` of it, or less for a bank of so many
+    /// modes that this would cost more than `BALANCE_MODE_SAMPLES`, and never less than the
+    /// first part, whose length is returned beside, where the peak is measured.
+    fn render_default_strike(&self) -> (Vec<[f32; COLUMNS]>, usize) {
         let controls = Controls::for_bank(&self.source);
         let n = self.num_modes();
         let mut bank = ResonatorBank::new(n);
@@ -175,27 +201,34 @@ impl PreparedBank {
         let mut exciter = Exciter::new(1);
         let contact = (controls.hardness_ms as f64 * 1e-3 * MEASURE_RATE_HZ).round() as u32;
         exciter.strike(controls.exciter, 1.0, contact);
-        let (wl, wr) = lane_weights(controls.width);
         // Long enough for the slowest beating of the lowest modes to build up.
         let lowest = self.freq_hz.first().copied().unwrap_or(100.0).max(1.0);
-        let seconds = (4.0 / lowest).clamp(0.2, 1.0);
+        let peak_s = (4.0 / lowest).clamp(0.2, 1.0);
+        let affordable_s = BALANCE_MODE_SAMPLES / (n.max(1) as f64 * MEASURE_RATE_HZ);
+        let seconds = affordable_s.min(BALANCE_S).max(peak_s);
         let total = (seconds * MEASURE_RATE_HZ) as usize;
         const RUN: usize = 256;
-        let mut acc = vec![[0.0f32; COLUMNS]; RUN];
+        let mut frames = vec![[0.0f32; COLUMNS]; total.div_ceil(RUN) * RUN];
+        let peak_len = ((peak_s * MEASURE_RATE_HZ) as usize).min(frames.len());
         let mut input = vec![0.0f32; RUN];
         let kernel = Kernel::from_env_or_detect();
-        let mut peak = 0.0f32;
-        for _ in 0..total.div_ceil(RUN) {
-            for a in acc.iter_mut() {
-                *a = [0.0; COLUMNS];
-            }
+        for run in frames.chunks_mut(RUN) {
             let driven = exciter.render(&mut input);
-            bank.process(kernel, driven.then_some(&input[..]), &mut acc);
-            for a in &acc {
-                let l: f32 = a.iter().zip(&wl).map(|(x, w)| x * w).sum();
-                let r: f32 = a.iter().zip(&wr).map(|(x, w)| x * w).sum();
-                peak = peak.max(l.abs()).max(r.abs());
-            }
+            bank.process(kernel, driven.then_some(&input[..]), run);
+        }
+        (frames, peak_len)
+    }
+
+    /// Peak of either channel of `frames` ([`Self::render_default_strike`]) at the bank's
+    /// default width with its column pans.
+    fn default_peak(&self, frames: &[[f32; COLUMNS]]) -> f32 {
+        let width = Controls::for_bank(&self.source).width;
+        let (wl, wr) = lane_weights(width, &self.column_pan);
+        let mut peak = 0.0f32;
+        for a in frames {
+            let l: f32 = a.iter().zip(&wl).map(|(x, w)| x * w).sum();
+            let r: f32 = a.iter().zip(&wr).map(|(x, w)| x * w).sum();
+            peak = peak.max(l.abs()).max(r.abs());
         }
         peak
     }

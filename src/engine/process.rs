@@ -82,7 +82,7 @@ impl Engine {
         s.tilt = tilt;
         s.gain = db_to_gain(self.controls.output_gain_db);
         s.input_gain = db_to_gain(self.controls.input_gain_db);
-        s.weights = lane_weights(self.controls.width);
+        s.weights = lane_weights(self.controls.width, &self.bank.column_pan);
         s.weight_target = s.weights;
         s.weight_ramp_left = 0;
     }
@@ -147,7 +147,7 @@ impl Engine {
             }
         }
         // Stereo width: ramp the column weights over the next period.
-        let target = lane_weights(self.controls.width);
+        let target = lane_weights(self.controls.width, &self.bank.column_pan);
         if target != self.smoothed.weights && self.smoothed.weight_ramp_left == 0 {
             let inv = 1.0 / CONTROL_PERIOD as f32;
             for j in 0..COLUMNS {
