@@ -361,8 +361,8 @@ impl Engine {
             tilt: 0.0,
             gain: 1.0,
             input_gain: 1.0,
-            weights: lane_weights(controls.width),
-            weight_target: lane_weights(controls.width),
+            weights: lane_weights(controls.width, &bank.column_pan),
+            weight_target: lane_weights(controls.width, &bank.column_pan),
             weight_step: ([0.0; COLUMNS], [0.0; COLUMNS]),
             weight_ramp_left: 0,
         };
@@ -472,8 +472,8 @@ impl Engine {
             tilt,
             gain: db_to_gain(self.controls.output_gain_db),
             input_gain: db_to_gain(self.controls.input_gain_db),
-            weights: lane_weights(self.controls.width),
-            weight_target: lane_weights(self.controls.width),
+            weights: lane_weights(self.controls.width, &self.bank.column_pan),
+            weight_target: lane_weights(self.controls.width, &self.bank.column_pan),
             weight_step: ([0.0; COLUMNS], [0.0; COLUMNS]),
             weight_ramp_left: 0,
         };

@@ -14,7 +14,7 @@ use std::sync::Arc;
 
 pub use midi_file::read_midi_file;
 pub use notes::{parse_notes, Note};
-pub use wav::{to_int_sample, wav_bytes, write_wav, BitDepth};
+pub use wav::{to_int_sample, wav_bytes, write_wav, BitDepth, WavFile};
 
 use crate::dsp::coeffs::{db_to_gain, gain_to_db};
 use crate::engine::{Controls, Engine, NoteEvent, PreparedBank};
@@ -27,25 +27,6 @@ pub const TAIL_MARGIN_S: f64 = 0.1;
 /// Length of the fade applied when the maximum length cuts a sound short, in seconds: long
 /// enough not to click.
 pub const CUT_FADE_S: f64 = 0.01;
-
-/// Fades the last `len` samples of both channels linearly to zero.
-fn fade_out(left: &mut [f32], right: &mut [f32], len: usize) {
-    let len = len.min(left.len());
-    let start = left.len() - len;
-    for (i, (l, r)) in left[start..]
-        .iter_mut()
-        .zip(&mut right[start..])
-        .enumerate()
-    {
-        let gain = 1.0 - (i + 1) as f32 / len as f32;
-        *l *= gain;
-        *r *= gain;
-    }
-}
-
-/// Most samples per channel reserved up front (about 87 s at 48 kHz): the tail estimate can be
-/// far longer than the sound when notes are released early.
-const MAX_RESERVED_SAMPLES: usize = 1 << 22;
 
 /// How to render.
 #[derive(Debug, Clone, PartialEq)]
@@ -253,21 +234,85 @@ fn estimated_tail_s(bank: &PreparedBank, controls: &Controls) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// Renders `notes` (in any order) through `bank` with `settings`, calling `progress` with the
-/// fraction done (0 to 1, an estimate until the end) after each block.
-///
-/// Stops at `settings.max_seconds`, or once every note has been played and released and the
-/// engine is silent; a silent render is then trimmed to [`TAIL_MARGIN_S`] after its last sound
-/// or last event, so its length does not depend on the block size either.
-///
-/// # Panics
-/// If the sample rate is below 8000 Hz.
+/// What a render produced, besides its samples.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RenderSummary {
+    /// Length in samples per channel.
+    pub len: u64,
+    /// Sample rate in Hz.
+    pub sample_rate_hz: u32,
+    /// Largest absolute sample of either channel.
+    pub peak: f32,
+    /// Samples of either channel beyond full scale: clipped in an integer file.
+    pub clipped_samples: u64,
+    /// Most voices sounding at the end of any block.
+    pub max_voices: usize,
+    /// Whether `max_seconds` cut the render while it still sounded or had notes to play.
+    pub cut_short: bool,
+}
+
+impl RenderSummary {
+    /// Length in seconds.
+    pub fn duration_s(&self) -> f64 {
+        self.len as f64 / self.sample_rate_hz as f64
+    }
+
+    /// Peak level in dBFS (negative infinity for silence).
+    pub fn peak_dbfs(&self) -> f32 {
+        match self.peak {
+            0.0 => f32::NEG_INFINITY,
+            peak => gain_to_db(peak),
+        }
+    }
+}
+
+/// Renders `notes` (in any order) through `bank` with `settings` into memory, as
+/// [`render_to`] renders them.
 pub fn render(
     bank: &Arc<PreparedBank>,
     notes: &[Note],
     settings: &RenderSettings,
-    mut progress: impl FnMut(f64),
+    progress: impl FnMut(f64),
 ) -> Rendered {
+    let mut left = Vec::new();
+    let mut right = Vec::new();
+    let sink = |l: &[f32], r: &[f32]| {
+        left.extend_from_slice(l);
+        right.extend_from_slice(r);
+        Ok::<(), std::convert::Infallible>(())
+    };
+    let Ok(summary) = render_to(bank, notes, settings, 1.0, progress, sink);
+    Rendered {
+        left,
+        right,
+        sample_rate_hz: summary.sample_rate_hz,
+        max_voices: summary.max_voices,
+        cut_short: summary.cut_short,
+    }
+}
+
+/// Renders `notes` (in any order) through `bank` with `settings`, every sample multiplied by
+/// `scale`, handing the stereo samples to `sink` in order as they are made (in pieces of any
+/// length, left and right of equal length) and calling `progress` with the fraction done (0 to
+/// 1, an estimate until the end) after each block. Memory does not grow with the length: only
+/// a run of silence, counted, and the last [`CUT_FADE_S`] before `max_seconds` wait before
+/// going to the sink. Stops at the first error of `sink`, and returns it.
+///
+/// Stops at `settings.max_seconds` (fading the last [`CUT_FADE_S`] out if it still sounds), or
+/// once every note has been played and released and the engine is silent; a silent render is
+/// then trimmed to [`TAIL_MARGIN_S`] after its last sound or last event, so its length does not
+/// depend on the block size either.
+///
+/// # Panics
+/// If the sample rate is below 8000 Hz.
+pub fn render_to<E>(
+    bank: &Arc<PreparedBank>,
+    notes: &[Note],
+    settings: &RenderSettings,
+    scale: f32,
+    mut progress: impl FnMut(f64),
+    sink: impl FnMut(&[f32], &[f32]) -> Result<(), E>,
+) -> Result<RenderSummary, E> {
     let rate = settings.sample_rate_hz as f64;
     let block = settings.block.max(1);
     let max_samples = (settings.max_seconds.max(0.0) * rate).round() as u64;
@@ -283,9 +328,10 @@ pub fn render(
         .min(max_samples as f64)
         .max(1.0);
 
-    let reserved = (estimated_len as usize).min(MAX_RESERVED_SAMPLES);
-    let mut left: Vec<f32> = Vec::with_capacity(reserved);
-    let mut right: Vec<f32> = Vec::with_capacity(reserved);
+    let fade_len = ((CUT_FADE_S * rate) as u64).min(max_samples);
+    let mut out = Stream::new(sink, max_samples - fade_len, scale);
+    let mut left = vec![0.0f32; block];
+    let mut right = vec![0.0f32; block];
     let mut block_events = Vec::with_capacity(events.len().min(4096));
     let mut next = 0;
     let mut pos = 0u64;
@@ -299,10 +345,11 @@ pub fn render(
             block_events.push(events[next].event.at((events[next].sample - pos) as u32));
             next += 1;
         }
-        let start = pos as usize;
-        left.resize(start + len as usize, 0.0);
-        right.resize(start + len as usize, 0.0);
-        engine.process(&block_events, None, &mut left[start..], &mut right[start..]);
+        let (l, r) = (&mut left[..len as usize], &mut right[..len as usize]);
+        l.fill(0.0);
+        r.fill(0.0);
+        engine.process(&block_events, None, l, r);
+        out.push(l, r)?;
         max_voices = max_voices.max(engine.stats().voices);
         pos += len;
         done = done.max((pos as f64 / estimated_len).min(0.99));
@@ -313,25 +360,146 @@ pub fn render(
     let end = if sounding {
         pos
     } else {
-        let last_sound_end = left
-            .iter()
-            .zip(&right)
-            .rposition(|(l, r)| *l != 0.0 || *r != 0.0)
-            .map_or(0, |i| i as u64 + 1);
         let margin = (TAIL_MARGIN_S * rate).round() as u64;
-        (last_sound_end.max(last_event_end) + margin).min(max_samples)
+        (out.sound_end().max(last_event_end) + margin).min(max_samples)
     };
-    left.resize(end as usize, 0.0);
-    right.resize(end as usize, 0.0);
-    if sounding {
-        fade_out(&mut left, &mut right, (CUT_FADE_S * rate) as usize);
-    }
+    out.finish(end, sounding.then_some(fade_len))?;
     progress(1.0);
-    Rendered {
-        left,
-        right,
+    Ok(RenderSummary {
+        len: end,
         sample_rate_hz: settings.sample_rate_hz,
+        peak: out.peak,
+        clipped_samples: out.clipped,
         max_voices,
         cut_short: sounding || dropped,
+    })
+}
+
+/// The samples of a render on their way to a sink: each is passed on as soon as it is known to
+/// be kept as it is, that is once a sound follows it, or (before `fade_start`) at once when it
+/// is not silent.
+struct Stream<F> {
+    sink: F,
+    /// Scale applied to every sample.
+    scale: f32,
+    /// Samples passed to the sink.
+    sent: u64,
+    /// Silent samples (both channels exactly 0) after the sent ones, not sent yet.
+    silent: u64,
+    /// First sample that waits for the end: the fade of a render cut while it sounds.
+    fade_start: u64,
+    /// Samples from `fade_start` on, waiting for the end.
+    held: (Vec<f32>, Vec<f32>),
+    /// One past the last sample that is not silent.
+    sound_end: u64,
+    /// Largest absolute sample sent.
+    peak: f32,
+    /// Samples sent beyond full scale.
+    clipped: u64,
+    /// Runs of silence, sent a piece at a time.
+    zeros: Vec<f32>,
+}
+
+impl<E, F: FnMut(&[f32], &[f32]) -> Result<(), E>> Stream<F> {
+    fn new(sink: F, fade_start: u64, scale: f32) -> Self {
+        Self {
+            sink,
+            scale,
+            sent: 0,
+            silent: 0,
+            fade_start,
+            held: (Vec::new(), Vec::new()),
+            sound_end: 0,
+            peak: 0.0,
+            clipped: 0,
+            zeros: vec![0.0; 4096],
+        }
+    }
+
+    /// One past the last sample that is not silent.
+    fn sound_end(&self) -> u64 {
+        self.sound_end
+    }
+
+    /// Takes the next samples (both slices of one length), scaling them in place.
+    fn push(&mut self, left: &mut [f32], right: &mut [f32]) -> Result<(), E> {
+        let start = self.sent + self.silent + self.held.0.len() as u64;
+        // Before scaling, so that a scaled render has the length of the unscaled one.
+        if let Some(last) = left
+            .iter()
+            .zip(&*right)
+            .rposition(|(l, r)| *l != 0.0 || *r != 0.0)
+        {
+            self.sound_end = start + last as u64 + 1;
+        }
+        if self.scale != 1.0 {
+            for x in left.iter_mut().chain(right.iter_mut()) {
+                *x *= self.scale;
+            }
+        }
+        let before_fade = (self.fade_start.saturating_sub(start) as usize).min(left.len());
+        let (left, fade_left) = left.split_at(before_fade);
+        let (right, fade_right) = right.split_at(before_fade);
+        self.held.0.extend_from_slice(fade_left);
+        self.held.1.extend_from_slice(fade_right);
+        // Everything up to the last sound goes out now; the silence after it waits.
+        match left
+            .iter()
+            .zip(right)
+            .rposition(|(l, r)| *l != 0.0 || *r != 0.0)
+        {
+            Some(last) => {
+                self.send_silence(self.silent)?;
+                self.send(&left[..=last], &right[..=last])?;
+                self.silent = (left.len() - last - 1) as u64;
+            }
+            None => self.silent += left.len() as u64,
+        }
+        Ok(())
+    }
+
+    /// Ends the render at sample `end`, fading the last `fade` samples out when asked.
+    fn finish(&mut self, end: u64, fade: Option<u64>) -> Result<(), E> {
+        let silent = self.silent.min(end.saturating_sub(self.sent));
+        self.send_silence(silent)?;
+        let mut held = std::mem::take(&mut self.held);
+        let keep = (end.saturating_sub(self.sent) as usize).min(held.0.len());
+        held.0.truncate(keep);
+        held.1.truncate(keep);
+        if let Some(fade) = fade {
+            let len = (fade as usize).min(keep);
+            let start = keep - len;
+            for (i, (l, r)) in held.0[start..]
+                .iter_mut()
+                .zip(&mut held.1[start..])
+                .enumerate()
+            {
+                let gain = 1.0 - (i + 1) as f32 / len as f32;
+                *l *= gain;
+                *r *= gain;
+            }
+        }
+        self.send(&held.0, &held.1)?;
+        let rest = end.saturating_sub(self.sent);
+        self.send_silence(rest)
+    }
+
+    fn send(&mut self, left: &[f32], right: &[f32]) -> Result<(), E> {
+        for &x in left.iter().chain(right) {
+            self.peak = self.peak.max(x.abs());
+            self.clipped += u64::from(x.abs() > 1.0);
+        }
+        self.sent += left.len() as u64;
+        (self.sink)(left, right)
+    }
+
+    fn send_silence(&mut self, mut count: u64) -> Result<(), E> {
+        while count > 0 {
+            let n = (count as usize).min(self.zeros.len());
+            self.sent += n as u64;
+            count -= n as u64;
+            (self.sink)(&self.zeros[..n], &self.zeros[..n])?;
+        }
+        Ok(())
     }
 }

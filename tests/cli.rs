@@ -1435,3 +1435,67 @@ fn an_interrupted_render_leaves_nothing_behind() {
         );
     }
 }
+
+/// The exit status and peak resident memory, in bytes, of `child` once it ends.
+fn wait_with_peak_memory(child: std::process::Child) -> (std::process::ExitStatus, u64) {
+    use std::os::unix::process::ExitStatusExt;
+    let mut status = 0;
+    // SAFETY: an all-zero rusage is a valid value for wait4 to fill.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: waits for the child this test started and has not reaped, with valid pointers.
+    let pid = unsafe { libc::wait4(child.id() as i32, &mut status, 0, &mut usage) };
+    assert_eq!(pid, child.id() as i32, "wait4 failed");
+    // ru_maxrss is in kilobytes on Linux.
+    (
+        std::process::ExitStatus::from_raw(status),
+        usage.ru_maxrss as u64 * 1024,
+    )
+}
+
+#[test]
+fn a_long_render_streams_to_disk_in_bounded_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    // A mode that barely decays rings to the end: 300 s of 32-bit stereo, a 115 MB file, which
+    // a render held in memory would need as much again to hold.
+    let mut bank = common::simple_bank(&[(440.0, 0.01, 1.0)]);
+    bank.root_hz = Some(440.0);
+    std::fs::write(
+        dir.path().join("bank.json"),
+        serde_json::to_string(&bank).unwrap(),
+    )
+    .unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_modal-resonator"))
+        .current_dir(dir.path())
+        .args([
+            "render",
+            "bank.json",
+            "--notes",
+            "69:1@0+300",
+            "--max-seconds",
+            "300",
+            "--bits",
+            "32",
+            "-o",
+            "out.wav",
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let (status, peak_bytes) = wait_with_peak_memory(child);
+    assert!(status.success(), "{status}");
+    let file_bytes = std::fs::metadata(dir.path().join("out.wav")).unwrap().len();
+    println!("a {file_bytes}-byte render in {peak_bytes} bytes of memory at most");
+    assert!(file_bytes > 115_000_000, "{file_bytes}");
+    assert!(
+        peak_bytes < file_bytes / 4,
+        "the render took {peak_bytes} bytes of memory for a {file_bytes}-byte file"
+    );
+    // The file is whole: its header gives every sample, and the end is faded out.
+    let mut reader = hound::WavReader::open(dir.path().join("out.wav")).unwrap();
+    assert_eq!(reader.duration(), 300 * 48_000);
+    let samples: Vec<f32> = reader.samples::<f32>().map(Result::unwrap).collect();
+    let tail = &samples[samples.len() - 2..];
+    assert!(tail.iter().all(|x| x.abs() < 1e-3), "{tail:?}");
+    assert!(samples[samples.len() / 2..].iter().any(|x| x.abs() > 0.1));
+}

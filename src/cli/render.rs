@@ -1,5 +1,6 @@
 //! `modal-resonator render`: notes or a MIDI file through a bank to a WAV file.
 
+use std::convert::Infallible;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -9,7 +10,8 @@ use clap::Args;
 
 use modal_resonator::engine::{Controls, PreparedBank};
 use modal_resonator::render::{
-    parse_notes, read_midi_file, render, wav_bytes, write_wav, BitDepth, Note, RenderSettings,
+    parse_notes, read_midi_file, render_to, wav_bytes, BitDepth, Note, RenderSettings, Rendered,
+    WavFile,
 };
 
 use super::progress::Progress;
@@ -99,26 +101,82 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
 
     let mut progress = Progress::new("rendering");
     let bank = Arc::new(PreparedBank::new(&bank));
-    let mut rendered = render(&bank, &notes, &settings, |done| progress.set(done));
-    let elapsed = progress.finish();
-    if let Some(peak_dbfs) = args.normalize {
-        rendered.normalize(peak_dbfs);
-    }
-    // Under half its least level, a sample is written as zero.
-    let silent = rendered.peak() < 0.5 * args.bits.least_level();
-    if to_stdout {
-        let bytes = wav_bytes(&rendered, args.bits, args.rate)
+    // With --normalize, a first pass finds the peak; renders are reproducible, so the second,
+    // scaled, has the same samples.
+    let (scale, first_share) = match args.normalize {
+        Some(peak_dbfs) => {
+            let quiet = |_: &[f32], _: &[f32]| Ok::<(), Infallible>(());
+            let Ok(first) = render_to(
+                &bank,
+                &notes,
+                &settings,
+                1.0,
+                |d| progress.set(0.5 * d),
+                quiet,
+            );
+            let scale = if first.peak > 0.0 {
+                10f32.powf(peak_dbfs / 20.0) / first.peak
+            } else {
+                1.0
+            };
+            (scale, 0.5)
+        }
+        None => (1.0, 0.0),
+    };
+    let share = |done: f64| first_share + (1.0 - first_share) * done;
+    let rendered = if to_stdout {
+        // A stream cannot seek back to fill in the header: the WAV is built in memory.
+        let (mut left, mut right) = (Vec::new(), Vec::new());
+        let collect = |l: &[f32], r: &[f32]| {
+            left.extend_from_slice(l);
+            right.extend_from_slice(r);
+            Ok::<(), Infallible>(())
+        };
+        let Ok(rendered) = render_to(
+            &bank,
+            &notes,
+            &settings,
+            scale,
+            |d| progress.set(share(d)),
+            collect,
+        );
+        let whole = Rendered {
+            left,
+            right,
+            sample_rate_hz: args.rate,
+            max_voices: rendered.max_voices,
+            cut_short: rendered.cut_short,
+        };
+        let bytes = wav_bytes(&whole, args.bits, args.rate)
             .map_err(|e| format!("standard output: cannot write WAV: {e}"))?;
         let mut out = std::io::stdout().lock();
         out.write_all(&bytes)
             .and_then(|()| out.flush())
             .map_err(|e| format!("standard output: {e}"))?;
+        rendered
     } else {
-        write_wav(&args.output, &rendered, args.bits, args.rate).map_err(|e| e.to_string())?;
-    }
+        // The samples go to disk as they are made; on any error the file is dropped unfinished,
+        // which removes it.
+        let mut file =
+            WavFile::create(&args.output, args.bits, args.rate).map_err(|e| e.to_string())?;
+        let rendered = render_to(
+            &bank,
+            &notes,
+            &settings,
+            scale,
+            |d| progress.set(share(d)),
+            |l, r| file.write(l, r),
+        )
+        .map_err(|e| e.to_string())?;
+        file.finish().map_err(|e| e.to_string())?;
+        rendered
+    };
+    let elapsed = progress.finish();
+    // Under half its least level, a sample is written as zero.
+    let silent = rendered.peak < 0.5 * args.bits.least_level();
 
     let peak_dbfs = rendered.peak_dbfs();
-    let clipped = args.bits != BitDepth::Float32 && rendered.peak() > 1.0;
+    let clipped = args.bits != BitDepth::Float32 && rendered.peak > 1.0;
     // With the WAV on standard output, the summary goes to standard error.
     let summary = format!(
         "{}: {:.2} s, {} Hz {}, peak {:.1} dBFS{}, up to {} voices, rendered in {:.2} s{}",
@@ -146,7 +204,7 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
         println!("{summary}");
     }
     if clipped {
-        let clips = rendered.clipped_samples();
+        let clips = rendered.clipped_samples;
         eprintln!(
             "warning: the render peaks at {peak_dbfs:+.1} dBFS: {clips} sample{} clipped in the \
              {} file. Render again with --normalize -1 (the peak at -1 dBFS), softer notes, \

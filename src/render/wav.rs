@@ -1,11 +1,14 @@
 //! Stereo WAV files, written atomically.
 
+use std::fs::File;
 use std::io::{BufWriter, Seek, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use hound::{SampleFormat, WavSpec, WavWriter};
 
 use super::{RenderError, Rendered};
+use tempfile::NamedTempFile;
+
 use crate::model::staged::{destination, temp_beside};
 
 /// Sample format of a WAV file.
@@ -72,43 +75,101 @@ pub fn to_int_sample(x: f32, bits: u16) -> i32 {
 }
 
 /// Writes `rendered` as a stereo WAV file at `path` with `bit_depth` and a sample rate of
-/// `sample_rate_hz` (normally `rendered.sample_rate_hz`). Integer depths round and clip (see
-/// [`to_int_sample`]); floats are written as they are, non-finite values as 0.
-///
-/// Atomic: the file is written to a temporary file in the destination directory and renamed into
-/// place, so on any failure neither a partial file nor the temporary file is left behind, and an
-/// existing file at `path` is untouched. The destination is where `path` leads
-/// ([`destination`]): a symbolic link's target is replaced, an existing file keeps its
-/// permissions, and a directory, device, named pipe or socket is refused.
+/// `sample_rate_hz` (normally `rendered.sample_rate_hz`), as [`WavFile`] writes it.
 pub fn write_wav(
     path: impl AsRef<Path>,
     rendered: &Rendered,
     bit_depth: BitDepth,
     sample_rate_hz: u32,
 ) -> Result<(), RenderError> {
-    let path = path.as_ref();
-    let io_error = |source| RenderError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let wav_error = |source| RenderError::Wav {
-        path: path.to_path_buf(),
-        source,
-    };
-    let destination = destination(path).map_err(io_error)?;
-    // Dropping `temp` on any early return deletes it.
-    let mut temp = temp_beside(&destination, ".modal-resonator-", ".wav.tmp").map_err(io_error)?;
-    encode(
-        BufWriter::new(temp.as_file_mut()),
-        rendered,
-        bit_depth,
-        sample_rate_hz,
-    )
-    .map_err(wav_error)?;
-    temp.as_file().sync_all().map_err(io_error)?;
-    temp.persist(&destination.path)
-        .map_err(|e| io_error(e.error))?;
-    Ok(())
+    let mut file = WavFile::create(path, bit_depth, sample_rate_hz)?;
+    file.write(&rendered.left, &rendered.right)?;
+    file.finish()
+}
+
+/// A stereo WAV file written a piece at a time, as a render goes, so that memory does not grow
+/// with its length. Integer depths round and clip (see [`to_int_sample`]); floats are written as
+/// they are, non-finite values as 0.
+///
+/// Atomic: the samples go to a temporary file in the destination directory, renamed into place
+/// by [`WavFile::finish`], so on any failure (or when dropped unfinished) neither a partial file
+/// nor the temporary file is left behind, and an existing file at `path` is untouched. The
+/// destination is where `path` leads ([`destination`]): a symbolic link's target is replaced, an
+/// existing file keeps its permissions, and a directory, device, named pipe or socket is refused.
+pub struct WavFile {
+    /// The path asked for, for messages.
+    path: PathBuf,
+    /// Where the file goes.
+    destination: PathBuf,
+    /// The temporary file; dropping it removes it.
+    temp: NamedTempFile,
+    writer: WavWriter<BufWriter<File>>,
+    bit_depth: BitDepth,
+}
+
+impl WavFile {
+    /// Starts a WAV file for `path`, checking the destination first.
+    pub fn create(
+        path: impl AsRef<Path>,
+        bit_depth: BitDepth,
+        sample_rate_hz: u32,
+    ) -> Result<Self, RenderError> {
+        let path = path.as_ref().to_path_buf();
+        let destination = destination(&path).map_err(|source| RenderError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        let opened = temp_beside(&destination, ".modal-resonator-", ".wav.tmp")
+            .and_then(|temp| temp.as_file().try_clone().map(|file| (temp, file)));
+        let (temp, file) = opened.map_err(|source| RenderError::Io {
+            path: path.clone(),
+            source,
+        })?;
+        let writer = WavWriter::new(BufWriter::new(file), spec(bit_depth, sample_rate_hz))
+            .map_err(|source| RenderError::Wav {
+                path: path.clone(),
+                source,
+            })?;
+        Ok(Self {
+            path,
+            destination: destination.path,
+            temp,
+            writer,
+            bit_depth,
+        })
+    }
+
+    /// Appends stereo samples (`left` and `right` of one length).
+    pub fn write(&mut self, left: &[f32], right: &[f32]) -> Result<(), RenderError> {
+        write_samples(&mut self.writer, left, right, self.bit_depth).map_err(|source| {
+            RenderError::Wav {
+                path: self.path.clone(),
+                source,
+            }
+        })
+    }
+
+    /// Completes the header, writes the file to disk and puts it in place.
+    pub fn finish(self) -> Result<(), RenderError> {
+        let Self {
+            path,
+            destination,
+            temp,
+            writer,
+            ..
+        } = self;
+        let io_error = |source| RenderError::Io {
+            path: path.clone(),
+            source,
+        };
+        writer.finalize().map_err(|source| RenderError::Wav {
+            path: path.clone(),
+            source,
+        })?;
+        temp.as_file().sync_all().map_err(io_error)?;
+        temp.persist(&destination).map_err(|e| io_error(e.error))?;
+        Ok(())
+    }
 }
 
 /// `rendered` as the bytes of a WAV file, as [`write_wav`] writes it: for a stream (standard
@@ -123,14 +184,9 @@ pub fn wav_bytes(
     Ok(bytes.into_inner())
 }
 
-/// Encodes `rendered` as a stereo WAV file into `out`.
-fn encode<W: Write + Seek>(
-    out: W,
-    rendered: &Rendered,
-    bit_depth: BitDepth,
-    sample_rate_hz: u32,
-) -> hound::Result<()> {
-    let spec = WavSpec {
+/// The header of a stereo WAV file.
+fn spec(bit_depth: BitDepth, sample_rate_hz: u32) -> WavSpec {
+    WavSpec {
         channels: 2,
         sample_rate: sample_rate_hz,
         bits_per_sample: bit_depth.bits(),
@@ -138,18 +194,28 @@ fn encode<W: Write + Seek>(
             BitDepth::Float32 => SampleFormat::Float,
             _ => SampleFormat::Int,
         },
-    };
-    let mut writer = WavWriter::new(out, spec)?;
-    write_samples(&mut writer, rendered, bit_depth)?;
+    }
+}
+
+/// Encodes `rendered` as a stereo WAV file into `out`.
+fn encode<W: Write + Seek>(
+    out: W,
+    rendered: &Rendered,
+    bit_depth: BitDepth,
+    sample_rate_hz: u32,
+) -> hound::Result<()> {
+    let mut writer = WavWriter::new(out, spec(bit_depth, sample_rate_hz))?;
+    write_samples(&mut writer, &rendered.left, &rendered.right, bit_depth)?;
     writer.finalize()
 }
 
 fn write_samples<W: Write + Seek>(
     writer: &mut WavWriter<W>,
-    rendered: &Rendered,
+    left: &[f32],
+    right: &[f32],
     bit_depth: BitDepth,
 ) -> hound::Result<()> {
-    let frames = rendered.left.iter().zip(&rendered.right);
+    let frames = left.iter().zip(right);
     match bit_depth {
         BitDepth::Float32 => {
             for (&l, &r) in frames {
