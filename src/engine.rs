@@ -28,7 +28,7 @@ pub use controls::{
     MATERIAL_Q_RANGE, MAX_MODE_BUDGET, MAX_POLYPHONY, MAX_TARGET_LOAD_PCT, NUMERIC_CONTROLS,
     PLAYBACK_LEVEL_RANGE_DB_SPL,
 };
-pub use position::{PositionMap, PositionWeights};
+pub use position::{PositionMap, PositionWeights, StrikeAxis};
 pub use prepared::{PreparedBank, TARGET_PEAK};
 use pruning::Pruner;
 pub use pruning::PruningStats;

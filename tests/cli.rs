@@ -1499,3 +1499,37 @@ fn a_long_render_streams_to_disk_in_bounded_memory() {
     assert!(tail.iter().all(|x| x.abs() < 1e-3), "{tail:?}");
     assert!(samples[samples.len() / 2..].iter().any(|x| x.abs() > 0.1));
 }
+
+#[test]
+fn a_strike_setting_along_an_axis_the_bank_lacks_is_reported() {
+    let dir = tempfile::tempdir().unwrap();
+    let render = |set: &str| {
+        run(
+            dir.path(),
+            &[
+                "render",
+                "rosewood-marimba-bar",
+                "--notes",
+                "60:1@0",
+                "--set",
+                set,
+                "--max-seconds",
+                "0.2",
+                "-o",
+                "out.wav",
+            ],
+        )
+    };
+    // The bar's positions lie on a line: y changes nothing, and the user hears why.
+    let out = render("strike_y=0.3");
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out)
+            .contains("warning: --set strike_y: every position of this bank lies at the same y"),
+        "{}",
+        stderr(&out)
+    );
+    let out = render("strike_x=0.5");
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
+}

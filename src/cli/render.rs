@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use clap::Args;
 
-use modal_resonator::engine::{Controls, PreparedBank};
+use modal_resonator::engine::{Controls, PositionMap, PreparedBank};
 use modal_resonator::render::{
     parse_notes, read_midi_file, render_to, wav_bytes, BitDepth, Note, RenderSettings, Rendered,
     WavFile,
@@ -64,6 +64,22 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
         controls
             .set_by_name(name, value)
             .map_err(|e| format!("--set {name}={value}: {e}"))?;
+    }
+    let coords: Vec<Vec<f64>> = bank.positions.iter().map(|p| p.coords.clone()).collect();
+    let positions = PositionMap::new(&coords);
+    for (name, _) in &args.set {
+        let axis = match name.as_str() {
+            "strike_x" => 0,
+            "strike_y" => 1,
+            _ => continue,
+        };
+        if !positions.moves_along(axis) {
+            eprintln!(
+                "warning: --set {name}: every position of this bank lies at the same {}, so the \
+                 strike cannot move along it and the setting changes nothing",
+                if axis == 0 { "x" } else { "y" }
+            );
+        }
     }
     let notes: Vec<Note> = match (&args.notes, &args.midi) {
         (Some(text), _) => parse_notes(text).map_err(|e| format!("--notes: {e}"))?,

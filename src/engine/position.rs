@@ -25,18 +25,60 @@ impl PositionWeights {
     }
 }
 
-/// The bank's positions, normalised to the unit interval or square.
+/// The bank's positions as places on the object, and how a strike position (0 to 1 on each
+/// axis) finds them.
+///
+/// A strike position is a place on the object: on an axis whose coordinates all lie in 0 to 1
+/// (fractions of the object's length or width, as every factory bank gives them), 0.5 is the
+/// middle of the object whatever span the positions cover, and when they all lie in its first
+/// half (a bar measured from its end to its centre) the object is taken to mirror about its
+/// middle, so 0.75 sounds as 0.25. An axis in other units is stretched over 0 to 1 from its
+/// lowest to its highest position; one on which every position agrees is not an axis the
+/// strike can move along.
 #[derive(Debug, Clone)]
 pub struct PositionMap {
-    /// Normalised coordinates of each position (second value 0.5 on 1-D banks).
+    /// Each position's place on the unit interval or square (second value 0.5 on 1-D banks).
     coords: Vec<[f64; 2]>,
     /// 1 or 2.
     dims: usize,
+    /// Per axis, what it is to a strike.
+    axes: [StrikeAxis; 2],
+}
+
+/// How a strike position maps onto one axis of a bank's positions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StrikeAxis {
+    /// Coordinates are fractions of the object: a strike lands where it says.
+    Object,
+    /// As [`StrikeAxis::Object`], with every position in the first half: a strike beyond the middle
+    /// lands at its mirror image.
+    Mirrored,
+    /// Coordinates in other units, stretched from the lowest position (0) to the highest (1).
+    Stretched {
+        /// Lowest coordinate.
+        lo: f64,
+        /// Highest coordinate.
+        hi: f64,
+    },
+    /// Every position agrees on this axis (or the bank has no such axis): a strike cannot move
+    /// along it.
+    Fixed,
+}
+
+impl StrikeAxis {
+    /// Where strike position `s` (0 to 1) lands on this axis, in the units of
+    /// [`PositionMap::coords`].
+    fn place(self, s: f64) -> f64 {
+        match self {
+            StrikeAxis::Mirrored => s.min(1.0 - s),
+            StrikeAxis::Fixed => 0.5,
+            StrikeAxis::Object | StrikeAxis::Stretched { .. } => s,
+        }
+    }
 }
 
 impl PositionMap {
-    /// Normalises `coords` (each 1 or 2 values) per axis to 0..1 over their bounding box; an axis
-    /// on which every position agrees maps to 0.5.
+    /// The map of positions with coordinates `coords` (each 1 or 2 values): see [`PositionMap`].
     pub fn new(coords: &[Vec<f64>]) -> Self {
         let dims = coords
             .iter()
@@ -45,6 +87,7 @@ impl PositionMap {
             .unwrap_or(1)
             .clamp(1, 2);
         let mut out = vec![[0.5; 2]; coords.len()];
+        let mut axes = [StrikeAxis::Fixed; 2];
         for axis in 0..dims {
             let values = coords.iter().map(|c| c.get(axis).copied().unwrap_or(0.0));
             let (lo, hi) = values
@@ -52,11 +95,55 @@ impl PositionMap {
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
                     (lo.min(v), hi.max(v))
                 });
+            axes[axis] = if !(hi > lo) {
+                StrikeAxis::Fixed
+            } else if lo >= 0.0 && hi <= 0.5 {
+                StrikeAxis::Mirrored
+            } else if lo >= 0.0 && hi <= 1.0 {
+                StrikeAxis::Object
+            } else {
+                StrikeAxis::Stretched { lo, hi }
+            };
             for (o, v) in out.iter_mut().zip(values) {
-                o[axis] = if hi > lo { (v - lo) / (hi - lo) } else { 0.5 };
+                o[axis] = match axes[axis] {
+                    StrikeAxis::Fixed => 0.5,
+                    StrikeAxis::Object | StrikeAxis::Mirrored => v,
+                    StrikeAxis::Stretched { lo, hi } => (v - lo) / (hi - lo),
+                };
             }
         }
-        Self { coords: out, dims }
+        Self {
+            coords: out,
+            dims,
+            axes,
+        }
+    }
+
+    /// What each axis is to a strike: x, then y.
+    pub fn axes(&self) -> [StrikeAxis; 2] {
+        self.axes
+    }
+
+    /// Whether a strike position along `axis` (0 for x, 1 for y) changes the sound.
+    pub fn moves_along(&self, axis: usize) -> bool {
+        self.axes[axis] != StrikeAxis::Fixed
+    }
+
+    /// The strike position of the same place on the object as `s` on `axis` meant before strike
+    /// positions were places on the object (when 0 to 1 spanned the positions, lowest to
+    /// highest), for bringing old settings forward.
+    pub fn from_span_fraction(&self, axis: usize, s: f32) -> f32 {
+        let s = s.clamp(0.0, 1.0) as f64;
+        let (lo, hi) = self
+            .coords
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), c| {
+                (lo.min(c[axis]), hi.max(c[axis]))
+            });
+        match self.axes[axis] {
+            StrikeAxis::Object | StrikeAxis::Mirrored if hi > lo => (lo + s * (hi - lo)) as f32,
+            _ => s as f32,
+        }
     }
 
     /// Number of coordinates per position.
@@ -64,17 +151,21 @@ impl PositionMap {
         self.dims
     }
 
-    /// Normalised coordinates of each position.
+    /// Each position's place on the unit interval or square, in the units of a strike position.
     pub fn coords(&self) -> &[[f64; 2]] {
         &self.coords
     }
 
-    /// The blend of columns for a strike at `(x, y)` (normalised; `y` ignored on 1-D banks).
+    /// The blend of columns for a strike at `(x, y)`, places on the object (0 to 1; `y` ignored
+    /// on 1-D banks), after the symmetry of each axis.
     ///
     /// 1-D: linear between the neighbours on either side, the end position beyond the ends.
     /// 2-D: barycentric within the triangle of the three nearest positions, clamped to its edges.
     pub fn weights(&self, x: f32, y: f32) -> PositionWeights {
-        let p = [x.clamp(0.0, 1.0) as f64, y.clamp(0.0, 1.0) as f64];
+        let p = [
+            self.axes[0].place(x.clamp(0.0, 1.0) as f64),
+            self.axes[1].place(y.clamp(0.0, 1.0) as f64),
+        ];
         match (self.coords.len(), self.dims) {
             (0 | 1, _) => PositionWeights::single(0),
             (_, 1) => self.weights_1d(p[0]),
@@ -180,13 +271,56 @@ mod tests {
 
     #[test]
     fn one_dimension_interpolates_between_neighbours() {
-        let map = PositionMap::new(&[vec![0.5], vec![0.0], vec![0.25]]);
-        let w = map.weights(0.25, 0.0); // halfway between coords 0.0 and 0.25
+        // In metres along a 2 m rod: stretched from the lowest position to the highest.
+        let map = PositionMap::new(&[vec![1.0], vec![0.0], vec![0.5]]);
+        let w = map.weights(0.25, 0.0); // halfway between coords 0.0 and 0.5
         assert_eq!(w.count, 2);
         assert_eq!((w.index[0], w.index[1]), (1, 2));
         assert!((w.weight[0] - 0.5).abs() < 1e-6 && (w.weight[1] - 0.5).abs() < 1e-6);
         assert_eq!(map.weights(1.0, 0.0), PositionWeights::single(0));
         assert_eq!(map.weights(0.0, 0.0), PositionWeights::single(1));
+    }
+
+    #[test]
+    fn a_strike_position_is_a_place_on_the_object() {
+        // A bar measured from its end (0) to its centre (0.5), as the factory bars are.
+        let map = PositionMap::new(&[vec![0.4], vec![0.0], vec![0.25], vec![0.5]]);
+        assert_eq!(map.axes()[0], StrikeAxis::Mirrored);
+        // 0.5 is the middle of the bar, not the middle of the measured span.
+        assert_eq!(map.weights(0.5, 0.0), PositionWeights::single(3));
+        assert_eq!(map.weights(0.25, 0.0), PositionWeights::single(2));
+        // The far half mirrors the near one.
+        assert_eq!(map.weights(0.75, 0.0), PositionWeights::single(2));
+        assert_eq!(map.weights(1.0, 0.0), PositionWeights::single(1));
+        assert_eq!(map.weights(0.625, 0.0), map.weights(0.375, 0.0));
+        // y is not an axis of a line.
+        assert!(!map.moves_along(1));
+        assert_eq!(map.weights(0.5, 0.9), map.weights(0.5, 0.1));
+
+        // A bell measured from near its crown (0.25) to its rim (1): no mirror, and a strike
+        // above the highest position lands there.
+        let map = PositionMap::new(&[vec![0.875], vec![0.25], vec![0.5], vec![1.0]]);
+        assert_eq!(map.axes()[0], StrikeAxis::Object);
+        assert_eq!(map.weights(0.5, 0.0), PositionWeights::single(2));
+        assert_eq!(map.weights(0.125, 0.0), PositionWeights::single(1));
+
+        // A circular plate: radius along x, every position on one angle.
+        let map = PositionMap::new(&[vec![0.625, 0.0], vec![0.0, 0.0], vec![0.875, 0.0]]);
+        assert_eq!(map.axes(), [StrikeAxis::Object, StrikeAxis::Fixed]);
+        assert_eq!(map.weights(0.625, 0.3), PositionWeights::single(0));
+    }
+
+    #[test]
+    fn old_strike_positions_come_forward_to_the_same_place() {
+        let bar = PositionMap::new(&[vec![0.4], vec![0.0], vec![0.25], vec![0.5]]);
+        // 0.5 of the span from end to centre was the quarter point.
+        assert_eq!(bar.from_span_fraction(0, 0.5), 0.25);
+        assert_eq!(bar.from_span_fraction(0, 1.0), 0.5);
+        let bell = PositionMap::new(&[vec![0.9], vec![0.2], vec![1.0]]);
+        assert!((bell.from_span_fraction(0, 0.5) - 0.6).abs() < 1e-6);
+        // Stretched axes meant the span already.
+        let rod = PositionMap::new(&[vec![2.0], vec![0.0]]);
+        assert_eq!(rod.from_span_fraction(0, 0.3), 0.3);
     }
 
     #[test]
