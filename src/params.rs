@@ -37,7 +37,7 @@ pub mod poly_id {
 pub const MPE_DEFAULT_BEND_RANGE: f32 = 48.0;
 
 /// Version of the plugin state's own fields; raised when they change meaning.
-pub const STATE_FORMAT: u32 = 1;
+pub const STATE_FORMAT: u32 = 2;
 
 /// The state field holding [`STATE_FORMAT`].
 pub const STATE_FORMAT_FIELD: &str = "state-format";
@@ -150,7 +150,8 @@ impl<'a> PersistentField<'a, String> for BankField {
     }
 }
 
-/// The parameters shared by the instrument and the effect.
+/// The parameters shared by the instrument and the effect, in the groups hosts show (VST3 units,
+/// CLAP modules) and the editor draws.
 #[derive(Params)]
 pub struct ModalParams {
     /// The bank, as JSON.
@@ -163,64 +164,24 @@ pub struct ModalParams {
     #[persist = "editor-size"]
     pub editor_size: std::sync::RwLock<Option<(f32, f32)>>,
 
-    #[id = "mat"]
-    pub material: EnumParam<MaterialChoice>,
-    #[id = "q"]
-    pub material_q: FloatParam,
-    #[id = "tilt"]
-    pub damping_tilt: FloatParam,
-    #[id = "size"]
-    pub size: FloatParam,
-    #[id = "keytrk"]
-    pub key_tracking: FloatParam,
-    #[id = "fine"]
-    pub fine_tune: FloatParam,
-    #[id = "bendrg"]
-    pub bend_range: FloatParam,
-    #[id = "posx"]
-    pub strike_x: FloatParam,
-    #[id = "posy"]
-    pub strike_y: FloatParam,
-    #[id = "posvar"]
-    pub position_variation: FloatParam,
-    #[id = "exc"]
-    pub exciter: EnumParam<ExciterChoice>,
-    #[id = "hard"]
-    pub hardness: FloatParam,
-    #[id = "velsns"]
-    pub velocity_sensitivity: FloatParam,
-    #[id = "velhrd"]
-    pub velocity_to_hardness: FloatParam,
-    #[id = "reldmp"]
-    pub release_damping: FloatParam,
-    #[id = "trunc"]
-    pub truncation: FloatParam,
-    #[id = "poly"]
-    pub polyphony: IntParam,
-    #[id = "width"]
-    pub width: FloatParam,
-    #[id = "gain"]
-    pub output_gain: FloatParam,
-    #[id = "inmode"]
-    pub input_mode: EnumParam<InputMode>,
-    #[id = "ingain"]
-    pub input_gain: FloatParam,
-    #[id = "trigth"]
-    pub trigger_threshold: FloatParam,
-    #[id = "retrig"]
-    pub retrigger: FloatParam,
-    #[id = "mix"]
-    pub dry_wet: FloatParam,
-    #[id = "modwhl"]
-    pub mod_wheel_target: EnumParam<ExpressionTarget>,
-    #[id = "press"]
-    pub pressure_target: EnumParam<ExpressionTarget>,
-    /// MIDI Polyphonic Expression: each note on its own channel (2 to 16), whose pitch bend and
-    /// pressure shape that note alone; channel 1 stays global.
-    #[id = "mpe"]
-    pub mpe: BoolParam,
-    #[id = "mpebnd"]
-    pub mpe_bend_range: FloatParam,
+    /// The object's size and tuning.
+    #[nested(group = "Object")]
+    pub object: ObjectParams,
+    /// Where and how the object is struck.
+    #[nested(group = "Strike")]
+    pub strike: StrikeParams,
+    /// What the object is made of: how its modes decay.
+    #[nested(group = "Material")]
+    pub material: MaterialParams,
+    /// Polyphony, truncation and how MIDI expression plays the voices.
+    #[nested(group = "Voices")]
+    pub voices: VoiceParams,
+    /// The output's level, stereo width and mix.
+    #[nested(group = "Output")]
+    pub output: OutputParams,
+    /// The audio input: driving the modes or triggering strikes.
+    #[nested(group = "Input")]
+    pub input: InputParams,
     /// The host's bypass button: the output crossfades to the effect's dry input, or to silence
     /// for the instrument; the object keeps ringing underneath.
     #[id = "bypass"]
@@ -228,6 +189,121 @@ pub struct ModalParams {
     /// Perceptual pruning and the mode budget.
     #[nested(group = "Pruning")]
     pub pruning: PruningParams,
+}
+
+/// The object's size and tuning. Group "Object".
+#[derive(Params)]
+pub struct ObjectParams {
+    /// Size: scales every frequency (larger is lower).
+    #[id = "size"]
+    pub size: FloatParam,
+    /// How far the pitch follows the keys, in percent.
+    #[id = "keytrk"]
+    pub key_tracking: FloatParam,
+    /// Fine tune in cents.
+    #[id = "fine"]
+    pub fine_tune: FloatParam,
+    /// Pitch-bend range in semitones.
+    #[id = "bendrg"]
+    pub bend_range: FloatParam,
+}
+
+/// Where and how the object is struck. Group "Strike".
+#[derive(Params)]
+pub struct StrikeParams {
+    /// Strike position along the object.
+    #[id = "posx"]
+    pub strike_x: FloatParam,
+    /// Strike position across the object (2-D banks).
+    #[id = "posy"]
+    pub strike_y: FloatParam,
+    /// Random variation of the strike position from strike to strike.
+    #[id = "posvar"]
+    pub position_variation: FloatParam,
+    /// What strikes the object: mallet, impulse or noise burst.
+    #[id = "exc"]
+    pub exciter: EnumParam<ExciterChoice>,
+    /// Mallet contact time in ms (short = hard and bright).
+    #[id = "hard"]
+    pub hardness: FloatParam,
+    /// How much velocity sets the level.
+    #[id = "velsns"]
+    pub velocity_sensitivity: FloatParam,
+    /// How much velocity shortens the contact (harder strikes are brighter).
+    #[id = "velhrd"]
+    pub velocity_to_hardness: FloatParam,
+}
+
+/// What the object is made of: how its modes decay. Group "Material".
+#[derive(Params)]
+pub struct MaterialParams {
+    /// Material: the bank as authored, a preset material, or Q and tilt.
+    #[id = "mat"]
+    pub material: EnumParam<MaterialChoice>,
+    /// Material quality factor Q (for the custom material).
+    #[id = "q"]
+    pub material_q: FloatParam,
+    /// Damping tilt: decays scale by `(f / f_lowest) ^ tilt`.
+    #[id = "tilt"]
+    pub damping_tilt: FloatParam,
+    /// How fast a released note is damped (0 = it rings on).
+    #[id = "reldmp"]
+    pub release_damping: FloatParam,
+}
+
+/// Polyphony, truncation and how MIDI expression plays the voices. Group "Voices".
+#[derive(Params)]
+pub struct VoiceParams {
+    /// Most voices at once.
+    #[id = "poly"]
+    pub polyphony: IntParam,
+    /// Level below which a mode stops being computed.
+    #[id = "trunc"]
+    pub truncation: FloatParam,
+    /// What the mod wheel moves.
+    #[id = "modwhl"]
+    pub mod_wheel_target: EnumParam<ExpressionTarget>,
+    /// What channel pressure moves.
+    #[id = "press"]
+    pub pressure_target: EnumParam<ExpressionTarget>,
+    /// MIDI Polyphonic Expression: each note on its own channel (2 to 16), whose pitch bend and
+    /// pressure shape that note alone; channel 1 stays global.
+    #[id = "mpe"]
+    pub mpe: BoolParam,
+    /// Pitch-bend range of MPE member channels, in semitones.
+    #[id = "mpebnd"]
+    pub mpe_bend_range: FloatParam,
+}
+
+/// The output's level, stereo width and mix. Group "Output".
+#[derive(Params)]
+pub struct OutputParams {
+    /// Output gain in dB.
+    #[id = "gain"]
+    pub output_gain: FloatParam,
+    /// Stereo width of the modes.
+    #[id = "width"]
+    pub width: FloatParam,
+    /// Mix of the dry input (the effect's audio, the instrument's exciter) and the modes.
+    #[id = "mix"]
+    pub dry_wet: FloatParam,
+}
+
+/// The audio input: driving the modes or triggering strikes. Group "Input".
+#[derive(Params)]
+pub struct InputParams {
+    /// What the audio input does: nothing, drive the modes, or trigger strikes.
+    #[id = "inmode"]
+    pub input_mode: EnumParam<InputMode>,
+    /// Gain of the audio input in dB.
+    #[id = "ingain"]
+    pub input_gain: FloatParam,
+    /// Level of an onset that triggers a strike.
+    #[id = "trigth"]
+    pub trigger_threshold: FloatParam,
+    /// Shortest time between triggered strikes, in ms.
+    #[id = "retrig"]
+    pub retrigger: FloatParam,
 }
 
 fn percent(name: &str, default: f32) -> FloatParam {
@@ -254,134 +330,146 @@ impl ModalParams {
             bank: BankField::default(),
             state_format: AtomicU32::new(STATE_FORMAT),
             editor_size: std::sync::RwLock::new(None),
-            material: EnumParam::new("Material", MaterialChoice::Authored),
-            material_q: FloatParam::new(
-                "Q",
-                1000.0,
-                FloatRange::Skewed {
-                    min: MATERIAL_Q_RANGE.0,
-                    max: MATERIAL_Q_RANGE.1,
-                    factor: FloatRange::skew_factor(-2.0),
-                },
-            )
-            .with_step_size(1.0),
-            damping_tilt: FloatParam::new(
-                "Damping tilt",
-                d.damping_tilt,
-                FloatRange::Linear {
-                    min: -2.0,
-                    max: 2.0,
-                },
-            )
-            .with_step_size(0.01),
-            size: FloatParam::new(
-                "Size",
-                1.0,
-                FloatRange::SymmetricalSkewed {
-                    min: 0.25,
-                    max: 4.0,
-                    factor: FloatRange::skew_factor(-1.0),
-                    center: 1.0,
-                },
-            )
-            .with_unit(" x")
-            .with_step_size(0.001)
-            .with_smoother(SmoothingStyle::None)
-            .with_poly_modulation_id(poly_id::SIZE),
-            key_tracking: percent("Key tracking", d.key_tracking),
-            fine_tune: FloatParam::new(
-                "Fine tune",
-                0.0,
-                FloatRange::Linear {
-                    min: -100.0,
-                    max: 100.0,
-                },
-            )
-            .with_unit(" ct")
-            .with_step_size(0.1)
-            .with_poly_modulation_id(poly_id::FINE_TUNE),
-            bend_range: FloatParam::new(
-                "Pitch bend range",
-                2.0,
-                FloatRange::Linear {
-                    min: 0.0,
-                    max: 48.0,
-                },
-            )
-            .with_unit(" st")
-            .with_step_size(1.0),
-            strike_x: percent("Strike position", d.strike_x)
-                .with_poly_modulation_id(poly_id::STRIKE_X),
-            strike_y: percent("Strike position Y", d.strike_y)
-                .with_poly_modulation_id(poly_id::STRIKE_Y),
-            position_variation: percent("Position variation", 0.0),
-            exciter: EnumParam::new("Exciter", ExciterChoice::Mallet),
-            hardness: FloatParam::new(
-                "Hardness",
-                d.hardness_ms,
-                FloatRange::Skewed {
-                    min: 0.05,
-                    max: 20.0,
-                    factor: FloatRange::skew_factor(-2.5),
-                },
-            )
-            .with_unit(" ms")
-            .with_step_size(0.01)
-            .with_poly_modulation_id(poly_id::HARDNESS),
-            velocity_sensitivity: percent("Velocity sensitivity", 0.8),
-            velocity_to_hardness: percent("Velocity to hardness", 0.5),
-            release_damping: percent("Release damping", 0.0),
-            truncation: decibels("Truncation threshold", -96.0, -140.0, -60.0),
-            polyphony: IntParam::new(
-                "Polyphony",
-                16,
-                IntRange::Linear {
-                    min: 1,
-                    max: MAX_POLYPHONY as i32,
-                },
-            ),
-            width: percent("Stereo width", 0.5),
-            output_gain: decibels("Output gain", 0.0, -60.0, 12.0),
-            input_mode: EnumParam::new(
-                "Input mode",
-                if is_effect {
-                    InputMode::Direct
-                } else {
-                    InputMode::Off
-                },
-            ),
-            input_gain: decibels(
-                "Input gain",
-                if is_effect { -24.0 } else { 0.0 },
-                -60.0,
-                24.0,
-            ),
-            trigger_threshold: decibels("Trigger threshold", -30.0, -80.0, 0.0),
-            retrigger: FloatParam::new(
-                "Retrigger time",
-                50.0,
-                FloatRange::Linear {
-                    min: 5.0,
-                    max: 500.0,
-                },
-            )
-            .with_unit(" ms")
-            .with_step_size(1.0),
-            dry_wet: percent("Dry/wet", if is_effect { 0.5 } else { 1.0 }),
-            mod_wheel_target: EnumParam::new("Mod wheel", ExpressionTarget::Position),
-            pressure_target: EnumParam::new("Pressure", ExpressionTarget::Damping),
-            mpe: BoolParam::new("MPE", false),
+            object: ObjectParams {
+                size: FloatParam::new(
+                    "Size",
+                    1.0,
+                    FloatRange::SymmetricalSkewed {
+                        min: 0.25,
+                        max: 4.0,
+                        factor: FloatRange::skew_factor(-1.0),
+                        center: 1.0,
+                    },
+                )
+                .with_unit(" x")
+                .with_step_size(0.001)
+                .with_smoother(SmoothingStyle::None)
+                .with_poly_modulation_id(poly_id::SIZE),
+                key_tracking: percent("Key tracking", d.key_tracking),
+                fine_tune: FloatParam::new(
+                    "Fine tune",
+                    0.0,
+                    FloatRange::Linear {
+                        min: -100.0,
+                        max: 100.0,
+                    },
+                )
+                .with_unit(" ct")
+                .with_step_size(0.1)
+                .with_poly_modulation_id(poly_id::FINE_TUNE),
+                bend_range: FloatParam::new(
+                    "Pitch bend range",
+                    2.0,
+                    FloatRange::Linear {
+                        min: 0.0,
+                        max: 48.0,
+                    },
+                )
+                .with_unit(" st")
+                .with_step_size(1.0),
+            },
+            strike: StrikeParams {
+                strike_x: percent("Strike position", d.strike_x)
+                    .with_poly_modulation_id(poly_id::STRIKE_X),
+                strike_y: percent("Strike position Y", d.strike_y)
+                    .with_poly_modulation_id(poly_id::STRIKE_Y),
+                position_variation: percent("Position variation", 0.0),
+                exciter: EnumParam::new("Exciter", ExciterChoice::Mallet),
+                hardness: FloatParam::new(
+                    "Hardness",
+                    d.hardness_ms,
+                    FloatRange::Skewed {
+                        min: 0.05,
+                        max: 20.0,
+                        factor: FloatRange::skew_factor(-2.5),
+                    },
+                )
+                .with_unit(" ms")
+                .with_step_size(0.01)
+                .with_poly_modulation_id(poly_id::HARDNESS),
+                velocity_sensitivity: percent("Velocity sensitivity", 0.8),
+                velocity_to_hardness: percent("Velocity to hardness", 0.5),
+            },
+            material: MaterialParams {
+                material: EnumParam::new("Material", MaterialChoice::Authored),
+                material_q: FloatParam::new(
+                    "Q",
+                    1000.0,
+                    FloatRange::Skewed {
+                        min: MATERIAL_Q_RANGE.0,
+                        max: MATERIAL_Q_RANGE.1,
+                        factor: FloatRange::skew_factor(-2.0),
+                    },
+                )
+                .with_step_size(1.0),
+                damping_tilt: FloatParam::new(
+                    "Damping tilt",
+                    d.damping_tilt,
+                    FloatRange::Linear {
+                        min: -2.0,
+                        max: 2.0,
+                    },
+                )
+                .with_step_size(0.01),
+                release_damping: percent("Release damping", 0.0),
+            },
+            voices: VoiceParams {
+                polyphony: IntParam::new(
+                    "Polyphony",
+                    16,
+                    IntRange::Linear {
+                        min: 1,
+                        max: MAX_POLYPHONY as i32,
+                    },
+                ),
+                truncation: decibels("Truncation threshold", -96.0, -140.0, -60.0),
+                mod_wheel_target: EnumParam::new("Mod wheel", ExpressionTarget::Position),
+                pressure_target: EnumParam::new("Pressure", ExpressionTarget::Damping),
+                mpe: BoolParam::new("MPE", false),
+                mpe_bend_range: FloatParam::new(
+                    "MPE bend range",
+                    MPE_DEFAULT_BEND_RANGE,
+                    FloatRange::Linear {
+                        min: 0.0,
+                        max: 96.0,
+                    },
+                )
+                .with_unit(" st")
+                .with_step_size(1.0),
+            },
+            output: OutputParams {
+                output_gain: decibels("Output gain", 0.0, -60.0, 12.0),
+                width: percent("Stereo width", 0.5),
+                dry_wet: percent("Dry/wet", if is_effect { 0.5 } else { 1.0 }),
+            },
+            input: InputParams {
+                input_mode: EnumParam::new(
+                    "Input mode",
+                    if is_effect {
+                        InputMode::Direct
+                    } else {
+                        InputMode::Off
+                    },
+                ),
+                input_gain: decibels(
+                    "Input gain",
+                    if is_effect { -24.0 } else { 0.0 },
+                    -60.0,
+                    24.0,
+                ),
+                trigger_threshold: decibels("Trigger threshold", -30.0, -80.0, 0.0),
+                retrigger: FloatParam::new(
+                    "Retrigger time",
+                    50.0,
+                    FloatRange::Linear {
+                        min: 5.0,
+                        max: 500.0,
+                    },
+                )
+                .with_unit(" ms")
+                .with_step_size(1.0),
+            },
             bypass: BoolParam::new("Bypass", false).make_bypass(),
-            mpe_bend_range: FloatParam::new(
-                "MPE bend range",
-                MPE_DEFAULT_BEND_RANGE,
-                FloatRange::Linear {
-                    min: 0.0,
-                    max: 96.0,
-                },
-            )
-            .with_unit(" st")
-            .with_step_size(1.0),
             pruning: PruningParams::new(&d),
         }
     }
@@ -389,11 +477,11 @@ impl ModalParams {
     /// The parameter with polyphonic modulation id `poly_id`.
     fn poly_param(&self, poly_id: u32) -> Option<&FloatParam> {
         Some(match poly_id {
-            poly_id::FINE_TUNE => &self.fine_tune,
-            poly_id::SIZE => &self.size,
-            poly_id::STRIKE_X => &self.strike_x,
-            poly_id::STRIKE_Y => &self.strike_y,
-            poly_id::HARDNESS => &self.hardness,
+            poly_id::FINE_TUNE => &self.object.fine_tune,
+            poly_id::SIZE => &self.object.size,
+            poly_id::STRIKE_X => &self.strike.strike_x,
+            poly_id::STRIKE_Y => &self.strike.strike_y,
+            poly_id::HARDNESS => &self.strike.hardness,
             _ => return None,
         })
     }
@@ -421,9 +509,12 @@ impl ModalParams {
     /// The engine controls for the current values, with the channel's expression: pitch bend
     /// (-1 to 1), mod wheel and pressure (0 to 1).
     pub fn controls(&self, bend: f32, mod_wheel: f32, pressure: f32) -> Controls {
-        let (material_q, damping_tilt) = match self.material.value() {
-            MaterialChoice::Authored => (None, self.damping_tilt.value()),
-            MaterialChoice::Custom => (Some(self.material_q.value()), self.damping_tilt.value()),
+        let (material_q, damping_tilt) = match self.material.material.value() {
+            MaterialChoice::Authored => (None, self.material.damping_tilt.value()),
+            MaterialChoice::Custom => (
+                Some(self.material.material_q.value()),
+                self.material.damping_tilt.value(),
+            ),
             MaterialChoice::Plastic => (
                 Some(Material::Plastic.q()),
                 Material::Plastic.damping_tilt(),
@@ -436,11 +527,11 @@ impl ModalParams {
             MaterialChoice::Glass => (Some(Material::Glass.q()), Material::Glass.damping_tilt()),
             MaterialChoice::Metal => (Some(Material::Metal.q()), Material::Metal.damping_tilt()),
         };
-        let mut strike_x = self.strike_x.value();
+        let mut strike_x = self.strike.strike_x.value();
         let mut extra_damping = 0.0;
         for (target, amount) in [
-            (self.mod_wheel_target.value(), mod_wheel),
-            (self.pressure_target.value(), pressure),
+            (self.voices.mod_wheel_target.value(), mod_wheel),
+            (self.voices.pressure_target.value(), pressure),
         ] {
             match target {
                 ExpressionTarget::None => {}
@@ -451,28 +542,28 @@ impl ModalParams {
         Controls {
             material_q,
             damping_tilt,
-            size_ratio: self.size.value(),
-            key_tracking: self.key_tracking.value(),
-            fine_tune_cents: self.fine_tune.value(),
-            pitch_bend_semitones: bend * self.bend_range.value(),
+            size_ratio: self.object.size.value(),
+            key_tracking: self.object.key_tracking.value(),
+            fine_tune_cents: self.object.fine_tune.value(),
+            pitch_bend_semitones: bend * self.object.bend_range.value(),
             strike_x,
-            strike_y: self.strike_y.value(),
-            position_variation: self.position_variation.value(),
-            exciter: match self.exciter.value() {
+            strike_y: self.strike.strike_y.value(),
+            position_variation: self.strike.position_variation.value(),
+            exciter: match self.strike.exciter.value() {
                 ExciterChoice::Mallet => ExciterKind::Mallet,
                 ExciterChoice::Impulse => ExciterKind::Impulse,
                 ExciterChoice::Noise => ExciterKind::Noise,
             },
-            hardness_ms: self.hardness.value(),
-            velocity_sensitivity: self.velocity_sensitivity.value(),
-            velocity_to_hardness: self.velocity_to_hardness.value(),
-            release_damping: self.release_damping.value(),
+            hardness_ms: self.strike.hardness.value(),
+            velocity_sensitivity: self.strike.velocity_sensitivity.value(),
+            velocity_to_hardness: self.strike.velocity_to_hardness.value(),
+            release_damping: self.material.release_damping.value(),
             extra_damping: extra_damping.min(1.0),
-            truncation_db: self.truncation.value(),
-            polyphony: self.polyphony.value().clamp(1, MAX_POLYPHONY as i32) as usize,
-            width: self.width.value(),
-            output_gain_db: self.output_gain.value(),
-            input_gain_db: self.input_gain.value(),
+            truncation_db: self.voices.truncation.value(),
+            polyphony: self.voices.polyphony.value().clamp(1, MAX_POLYPHONY as i32) as usize,
+            width: self.output.width.value(),
+            output_gain_db: self.output.output_gain.value(),
+            input_gain_db: self.input.input_gain.value(),
             ..self.pruning.apply(Controls::default())
         }
     }

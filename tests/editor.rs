@@ -88,7 +88,8 @@ fn the_effect_editor_draws_at_every_size() {
         let screen = Rect::from_min_size(Pos2::ZERO, size);
         let layout = h.app.layout();
         assert!(screen.contains_rect(layout.mode_view) && screen.contains_rect(layout.strike_area));
-        let dry_wet = control_rect(&h.ctx, h.params.dry_wet.name()).expect("dry/wet is drawn");
+        let dry_wet =
+            control_rect(&h.ctx, h.params.output.dry_wet.name()).expect("dry/wet is drawn");
         assert!(dry_wet.width() > 50.0, "dry/wet at {dry_wet:?}");
     }
 }
@@ -109,20 +110,20 @@ fn every_parameter_has_a_labelled_control() {
 #[test]
 fn sliders_end_every_gesture_they_begin() {
     let mut h = Harness::new(None);
-    let name = h.params.size.name().to_string();
+    let name = h.params.object.size.name().to_string();
     let rect = control_rect(&h.ctx, &name).expect("the size slider is drawn");
-    let default = h.params.size.default_plain_value();
+    let default = h.params.object.size.default_plain_value();
 
     // A drag moves the value by the distance dragged, not to the pointer.
     let from = at(rect, 0.5, 0.5);
-    let before = h.params.size.unmodulated_normalized_value();
+    let before = h.params.object.size.unmodulated_normalized_value();
     h.drag(
         from,
         from + vec2(rect.width() * 0.2, 0.0),
         4,
         Modifiers::NONE,
     );
-    let after = h.params.size.unmodulated_normalized_value();
+    let after = h.params.object.size.unmodulated_normalized_value();
     assert!(
         (after - before - 0.2).abs() < 0.02,
         "dragged a fifth of the width: {before} -> {after}"
@@ -137,7 +138,7 @@ fn sliders_end_every_gesture_they_begin() {
         4,
         Modifiers::SHIFT,
     );
-    let after = h.params.size.unmodulated_normalized_value();
+    let after = h.params.object.size.unmodulated_normalized_value();
     assert!(
         (after - before - 0.02).abs() < 0.005,
         "fine drag of a fifth of the width: {before} -> {after}"
@@ -146,7 +147,7 @@ fn sliders_end_every_gesture_they_begin() {
 
     // A plain click changes nothing and leaves no gesture open.
     h.click(at(rect, 0.9, 0.5));
-    assert_eq!(h.params.size.unmodulated_normalized_value(), after);
+    assert_eq!(h.params.object.size.unmodulated_normalized_value(), after);
     assert!(h.gestures_balanced());
 
     // A double-click resets, in balanced gestures.
@@ -157,7 +158,7 @@ fn sliders_end_every_gesture_they_begin() {
         h.button(p, false, Modifiers::NONE);
     }
     h.settle();
-    assert_eq!(h.params.size.value(), default);
+    assert_eq!(h.params.object.size.value(), default);
     assert!(h.gestures_balanced());
 
     // So does a Ctrl-click.
@@ -167,13 +168,13 @@ fn sliders_end_every_gesture_they_begin() {
         3,
         Modifiers::NONE,
     );
-    assert_ne!(h.params.size.value(), default);
+    assert_ne!(h.params.object.size.value(), default);
     h.frame(vec![Event::ModifiersChanged(Modifiers::COMMAND)]);
     h.button(p, true, Modifiers::COMMAND);
     h.button(p, false, Modifiers::COMMAND);
     h.frame(vec![Event::ModifiersChanged(Modifiers::NONE)]);
     h.settle();
-    assert_eq!(h.params.size.value(), default);
+    assert_eq!(h.params.object.size.value(), default);
     assert!(h.gestures_balanced());
 }
 
@@ -199,7 +200,7 @@ fn hovering_a_stem_finds_its_mode() {
 fn pressing_the_strike_pad_auditions_there_and_dragging_moves_the_strike() {
     let mut h = Harness::new(None);
     let area = h.app.layout().strike_area;
-    let y = h.params.strike_y.value();
+    let y = h.params.strike.strike_y.value();
     h.move_to(at(area, 0.3, 0.5));
     h.button(at(area, 0.3, 0.5), true, Modifiers::NONE);
     let queued = h.auditions();
@@ -215,14 +216,14 @@ fn pressing_the_strike_pad_auditions_there_and_dragging_moves_the_strike() {
     assert!((x - 0.3).abs() < 0.01, "struck at {x}");
     assert_eq!(strike_y, y, "a 1-D bank keeps strike Y");
     assert!(velocity > 0.0 && velocity <= 1.0);
-    assert!((h.params.strike_x.value() - 0.3).abs() < 0.01);
+    assert!((h.params.strike.strike_x.value() - 0.3).abs() < 0.01);
 
     // Dragging moves the strike position without striking again; releasing ends the note.
     for x in [0.4, 0.5, 0.6] {
         h.move_to(at(area, x, 0.5));
     }
     assert!(h.auditions().is_empty());
-    assert!((h.params.strike_x.value() - 0.6).abs() < 0.01);
+    assert!((h.params.strike.strike_x.value() - 0.6).abs() < 0.01);
     h.button(at(area, 0.6, 0.5), false, Modifiers::NONE);
     assert_eq!(h.auditions(), vec![Audition::Release]);
     assert!(h.gestures_balanced());
@@ -247,7 +248,7 @@ fn the_strike_pad_of_a_surface_sets_both_coordinates() {
         "({x}, {y})"
     );
     assert_eq!(queued[1], Audition::Release);
-    assert!((h.params.strike_y.value() - 0.75).abs() < 0.01);
+    assert!((h.params.strike.strike_y.value() - 0.75).abs() < 0.01);
     assert!(h.gestures_balanced());
 }
 
@@ -375,9 +376,9 @@ fn loading_a_bank_file_plays_it_with_its_defaults() {
     assert_eq!(h.played(), bank);
     assert_eq!(h.app.stems_drawn(), bank.modes.len());
     let c = Controls::for_bank(&bank);
-    assert!((h.params.strike_x.value() - c.strike_x).abs() < 1e-3);
-    assert!((h.params.strike_y.value() - c.strike_y).abs() < 1e-3);
-    assert!((h.params.hardness.value() - c.hardness_ms).abs() < 0.01);
+    assert!((h.params.strike.strike_x.value() - c.strike_x).abs() < 1e-3);
+    assert!((h.params.strike.strike_y.value() - c.strike_y).abs() < 1e-3);
+    assert!((h.params.strike.hardness.value() - c.hardness_ms).abs() < 0.01);
     assert!(h.gestures_balanced());
 }
 

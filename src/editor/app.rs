@@ -267,7 +267,8 @@ impl EditorApp {
         Panel::top("header").show(ui, |ui| self.header(ui));
         Panel::bottom("meters").show(ui, |ui| {
             ui.add_space(2.0);
-            self.meters.show(ui, params.polyphony.value().max(1) as u32);
+            self.meters
+                .show(ui, params.voices.polyphony.value().max(1) as u32);
             ui.add_space(2.0);
         });
         Panel::left("parameters")
@@ -366,10 +367,10 @@ impl EditorApp {
     /// The mode view above the strike pad and the mode editor.
     fn central(&mut self, ui: &mut Ui, host: &Host) {
         let params = host.params;
-        let weights = self
-            .session
-            .positions()
-            .weights(params.strike_x.value(), params.strike_y.value());
+        let weights = self.session.positions().weights(
+            params.strike.strike_x.value(),
+            params.strike.strike_y.value(),
+        );
         let available = ui.available_size();
         let height = (available.y * MODE_VIEW_SHARE).max(MODE_VIEW_MIN_HEIGHT);
         let input = ViewInput {

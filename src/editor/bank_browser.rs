@@ -284,15 +284,15 @@ pub fn apply_bank_defaults(bank: &Bank, params: &ModalParams, setter: &ParamSett
     } else {
         MaterialChoice::Authored
     };
-    set(setter, &params.material, material);
+    set(setter, &params.material.material, material);
     if let Some(q) = c.material_q {
-        set(setter, &params.material_q, q);
+        set(setter, &params.material.material_q, q);
     }
-    set(setter, &params.damping_tilt, c.damping_tilt);
-    set(setter, &params.hardness, c.hardness_ms);
-    set(setter, &params.strike_x, c.strike_x);
-    set(setter, &params.strike_y, c.strike_y);
-    set(setter, &params.key_tracking, c.key_tracking);
+    set(setter, &params.material.damping_tilt, c.damping_tilt);
+    set(setter, &params.strike.hardness, c.hardness_ms);
+    set(setter, &params.strike.strike_x, c.strike_x);
+    set(setter, &params.strike.strike_y, c.strike_y);
+    set(setter, &params.object.key_tracking, c.key_tracking);
 }
 
 /// One whole host gesture setting `param` to `value`.

@@ -57,51 +57,51 @@ fn groups(p: &ModalParams) -> Vec<(&'static str, Vec<Control<'_>>)> {
     use Control::*;
     // The instrument's dry/wet mixes its exciter input, the effect's its audio input.
     let output = vec![
-        Float(&p.output_gain),
-        Float(&p.width),
-        Float(&p.dry_wet),
+        Float(&p.output.output_gain),
+        Float(&p.output.width),
+        Float(&p.output.dry_wet),
         Bool(&p.bypass),
     ];
     vec![
         (
             "Object",
             vec![
-                Float(&p.size),
-                Float(&p.key_tracking),
-                Float(&p.fine_tune),
-                Float(&p.bend_range),
+                Float(&p.object.size),
+                Float(&p.object.key_tracking),
+                Float(&p.object.fine_tune),
+                Float(&p.object.bend_range),
             ],
         ),
         (
             "Strike",
             vec![
-                Float(&p.strike_x),
-                Float(&p.strike_y),
-                Float(&p.position_variation),
-                Choice(&p.exciter),
-                Float(&p.hardness),
-                Float(&p.velocity_sensitivity),
-                Float(&p.velocity_to_hardness),
+                Float(&p.strike.strike_x),
+                Float(&p.strike.strike_y),
+                Float(&p.strike.position_variation),
+                Choice(&p.strike.exciter),
+                Float(&p.strike.hardness),
+                Float(&p.strike.velocity_sensitivity),
+                Float(&p.strike.velocity_to_hardness),
             ],
         ),
         (
             "Material",
             vec![
-                Choice(&p.material),
-                Float(&p.material_q),
-                Float(&p.damping_tilt),
-                Float(&p.release_damping),
+                Choice(&p.material.material),
+                Float(&p.material.material_q),
+                Float(&p.material.damping_tilt),
+                Float(&p.material.release_damping),
             ],
         ),
         (
             "Voices",
             vec![
-                Int(&p.polyphony),
-                Float(&p.truncation),
-                Choice(&p.mod_wheel_target),
-                Choice(&p.pressure_target),
-                Bool(&p.mpe),
-                Float(&p.mpe_bend_range),
+                Int(&p.voices.polyphony),
+                Float(&p.voices.truncation),
+                Choice(&p.voices.mod_wheel_target),
+                Choice(&p.voices.pressure_target),
+                Bool(&p.voices.mpe),
+                Float(&p.voices.mpe_bend_range),
             ],
         ),
         (
@@ -119,10 +119,10 @@ fn groups(p: &ModalParams) -> Vec<(&'static str, Vec<Control<'_>>)> {
         (
             "Input",
             vec![
-                Choice(&p.input_mode),
-                Float(&p.input_gain),
-                Float(&p.trigger_threshold),
-                Float(&p.retrigger),
+                Choice(&p.input.input_mode),
+                Float(&p.input.input_gain),
+                Float(&p.input.trigger_threshold),
+                Float(&p.input.retrigger),
             ],
         ),
     ]

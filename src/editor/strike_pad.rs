@@ -1,5 +1,6 @@
-//! The strike pad: the bank's positions on a line (1-D banks) or a plane (2-D banks) with the
-//! strike point. Pressing strikes the object there (auditions without MIDI) and holds the note
+//! The strike pad: the object as a line (1-D banks) or a plane (2-D banks), 0 to 1 along each
+//! axis, with the bank's positions where they lie on it (and, faint, where symmetry repeats them)
+//! and the strike point. Pressing strikes the object there (auditions without MIDI) and holds the note
 //! until released; dragging moves the strike position parameters.
 
 use egui::{pos2, vec2, Align2, CornerRadius, FontId, Pos2, Rect, Sense, Slider, Stroke, Ui, Vec2};
@@ -8,7 +9,7 @@ use nice_plug::prelude::ParamSetter;
 use super::app::Host;
 use super::style;
 use super::Audition;
-use crate::engine::PositionMap;
+use crate::engine::{PositionMap, StrikeAxis};
 use crate::params::ModalParams;
 
 /// Velocity of pad strikes until the player sets another.
@@ -92,7 +93,14 @@ impl StrikePad {
         let from_screen = |p: Pos2| {
             let x = ((p.x - area.left()) / area.width()).clamp(0.0, 1.0);
             let y = ((area.bottom() - p.y) / area.height()).clamp(0.0, 1.0);
-            (x, if two_d { y } else { params.strike_y.value() })
+            (
+                x,
+                if two_d {
+                    y
+                } else {
+                    params.strike.strike_y.value()
+                },
+            )
         };
 
         // Press: strike there; drag: move the strike point; release: end the note.
@@ -100,9 +108,9 @@ impl StrikePad {
         if pressed && response.contains_pointer() {
             if let Some(p) = ui.input(|i| i.pointer.interact_pos()) {
                 let (x, y) = from_screen(p);
-                setter.begin_set_parameter(&params.strike_x);
+                setter.begin_set_parameter(&params.strike.strike_x);
                 if two_d {
-                    setter.begin_set_parameter(&params.strike_y);
+                    setter.begin_set_parameter(&params.strike.strike_y);
                 }
                 self.set_position(params, setter, x, y, two_d);
                 shared.request(Audition::Strike {
@@ -121,9 +129,9 @@ impl StrikePad {
         if self.held && !down {
             self.held = false;
             shared.request(Audition::Release);
-            setter.end_set_parameter(&params.strike_x);
+            setter.end_set_parameter(&params.strike.strike_x);
             if two_d {
-                setter.end_set_parameter(&params.strike_y);
+                setter.end_set_parameter(&params.strike.strike_y);
             }
         }
 
@@ -144,6 +152,21 @@ impl StrikePad {
                 Stroke::new(2.0, style::GRID),
             );
         }
+        // Where a mirrored axis repeats the measured positions, they are drawn again, faint.
+        let [mirror_x, mirror_y] = positions.axes().map(|a| a == StrikeAxis::Mirrored);
+        for c in positions.coords() {
+            let (x, y) = (c[0] as f32, c[1] as f32);
+            let images = [
+                (mirror_x && x < 0.5, 1.0 - x, y),
+                (mirror_y && y < 0.5, x, 1.0 - y),
+                (mirror_x && mirror_y && x < 0.5 && y < 0.5, 1.0 - x, 1.0 - y),
+            ];
+            for (shown, ix, iy) in images {
+                if shown {
+                    painter.circle_stroke(to_screen(ix, iy), 3.5, (1.0, style::POSITION));
+                }
+            }
+        }
         for (k, c) in positions.coords().iter().enumerate() {
             let p = to_screen(c[0] as f32, c[1] as f32);
             painter.circle_filled(p, 4.0, style::POSITION);
@@ -156,7 +179,10 @@ impl StrikePad {
                 painter.text(p + offset, align, name, font.clone(), style::LABEL);
             }
         }
-        let strike = to_screen(params.strike_x.value(), params.strike_y.value());
+        let strike = to_screen(
+            params.strike.strike_x.value(),
+            params.strike.strike_y.value(),
+        );
         let colour = style::STRIKE;
         painter.circle_stroke(strike, 7.0, Stroke::new(2.0, colour));
         painter.line_segment(
@@ -187,9 +213,9 @@ impl StrikePad {
         y: f32,
         two_d: bool,
     ) {
-        setter.set_parameter(&params.strike_x, x);
+        setter.set_parameter(&params.strike.strike_x, x);
         if two_d {
-            setter.set_parameter(&params.strike_y, y);
+            setter.set_parameter(&params.strike.strike_y, y);
         }
     }
 }

@@ -77,9 +77,10 @@ impl<K: Kind> ModalPlugin<K> {
     pub(super) fn read_events(&mut self, context: &mut impl ProcessContext<Self>) {
         self.events.clear();
         self.changes.clear();
-        let mpe = self.params.mpe.value();
-        let mpe_range = self.params.mpe_bend_range.value();
-        let pressure_damps = self.params.pressure_target.value() == ExpressionTarget::Damping;
+        let mpe = self.params.voices.mpe.value();
+        let mpe_range = self.params.voices.mpe_bend_range.value();
+        let pressure_damps =
+            self.params.voices.pressure_target.value() == ExpressionTarget::Damping;
         let is_member = |channel: u8| mpe && channel != MPE_MANAGER_CHANNEL;
         self.read_auditions();
         while let Some(event) = context.next_event() {

@@ -13,6 +13,7 @@ use std::sync::{Arc, RwLock};
 use std::time::Instant;
 
 use nice_plug::midi::{Channel, Key, VoiceID};
+use nice_plug::plugin::ParamValue;
 use nice_plug::prelude::*;
 use nice_plug_egui::{EguiEditor, EguiEditorState};
 
@@ -22,7 +23,7 @@ pub use kind::{Effect, Instrument, Kind};
 use crate::dsp::denormal::flush_subnormals;
 use crate::dsp::onset::OnsetDetector;
 use crate::editor::{self, EditorApp, EditorLinks, EditorShared, AUDITION_NOTE_ID};
-use crate::engine::{EndedVoice, NoteEvent as EngineEvent, MAX_POLYPHONY};
+use crate::engine::{EndedVoice, NoteEvent as EngineEvent, PositionMap, MAX_POLYPHONY};
 use crate::params::{InputMode, ModalParams, STATE_FORMAT, STATE_FORMAT_FIELD};
 use engines::Engines;
 use events::{ControlChange, Expression};
@@ -179,8 +180,8 @@ impl<K: Kind> ModalPlugin<K> {
     /// Adds a strike at each onset of `self.input[..n]` (trigger mode) to the segment's events,
     /// keeping them in time order.
     fn add_onsets(&mut self, n: usize) {
-        let threshold = util::db_to_gain(self.params.trigger_threshold.value());
-        let retrigger_s = self.params.retrigger.value() * 1e-3;
+        let threshold = util::db_to_gain(self.params.input.trigger_threshold.value());
+        let retrigger_s = self.params.input.retrigger.value() * 1e-3;
         let key = self.strike_key();
         let events = &mut self.segment_events;
         self.onsets
@@ -207,7 +208,7 @@ impl<K: Kind> ModalPlugin<K> {
     ) {
         let n = end - start;
         // The audio input: the effect's main input, or the instrument's exciter input.
-        let mode = self.params.input_mode.value();
+        let mode = self.params.input.input_mode.value();
         let mut have_input = false;
         if K::IS_EFFECT {
             for (dry, channel) in self.dry.iter_mut().zip(channels.iter()) {
@@ -274,7 +275,7 @@ impl<K: Kind> ModalPlugin<K> {
         // Dry/wet: the effect's input, or the instrument's exciter input when it has one.
         if have_input {
             // Ramp from the last segment's mix to this one's, so automation does not zipper.
-            let to = self.params.dry_wet.value();
+            let to = self.params.output.dry_wet.value();
             let from = self.wet.unwrap_or(to);
             let step = (to - from) / n as f32;
             for (channel, dry) in channels.iter_mut().zip(&self.dry) {
@@ -595,20 +596,40 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
 }
 
 /// Brings a saved state up to [`STATE_FORMAT`]: states saved before the format was recorded are
-/// format 1, which is still current. A state from a newer version keeps its fields (its newer
-/// ones are ignored).
+/// format 1. A state from a newer version keeps its fields (its newer ones are ignored).
+///
+/// Format 2: a strike position is a place on the object; in format 1 it was a fraction of the
+/// span of the bank's positions, so a saved position is moved to the place it meant.
 pub fn migrate_state(state: &mut PluginState) {
     let format = state
         .fields
         .get(STATE_FORMAT_FIELD)
         .and_then(|f| f.trim().parse::<u32>().ok())
         .unwrap_or(1);
-    if format <= STATE_FORMAT {
-        // Migrations from older formats go here, one step at a time.
-        state
-            .fields
-            .insert(STATE_FORMAT_FIELD.to_string(), STATE_FORMAT.to_string());
+    if format > STATE_FORMAT {
+        return;
     }
+    if format < 2 {
+        let json = state
+            .fields
+            .get("bank")
+            .and_then(|field| serde_json::from_str::<String>(field).ok())
+            .unwrap_or_default();
+        // A bank that does not load is replaced by the last good one, whose positions are not
+        // known here: its strike position stays as it was.
+        if let Ok(bank) = bank_from_state(&json) {
+            let coords: Vec<Vec<f64>> = bank.positions.iter().map(|p| p.coords.clone()).collect();
+            let map = PositionMap::new(&coords);
+            for (axis, id) in [(0, "posx"), (1, "posy")] {
+                if let Some(ParamValue::F32(value)) = state.params.get_mut(id) {
+                    *value = map.from_span_fraction(axis, *value);
+                }
+            }
+        }
+    }
+    state
+        .fields
+        .insert(STATE_FORMAT_FIELD.to_string(), STATE_FORMAT.to_string());
 }
 
 /// `out = (left + right) / 2`.
@@ -653,6 +674,22 @@ mod tests {
                 .map(|(k, v)| (k.to_string(), v.to_string()))
                 .collect(),
         }
+    }
+
+    #[test]
+    fn a_format_1_strike_position_comes_forward_to_the_place_it_meant() {
+        // The default bank, a marimba bar measured from its end to its centre: 0.5 of that span
+        // was the quarter point of the bar.
+        let mut old = state_with(&[("bank", "\"\"")]);
+        old.params.insert("posx".into(), ParamValue::F32(0.5));
+        old.params.insert("posy".into(), ParamValue::F32(0.3));
+        migrate_state(&mut old);
+        assert!(matches!(old.params["posx"], ParamValue::F32(x) if x == 0.25));
+        // A line has no y to move along: kept.
+        assert!(matches!(old.params["posy"], ParamValue::F32(y) if y == 0.3));
+        // Once migrated, it stays.
+        migrate_state(&mut old);
+        assert!(matches!(old.params["posx"], ParamValue::F32(x) if x == 0.25));
     }
 
     #[test]
