@@ -762,7 +762,8 @@ fn polyphonic_modulation_shapes_one_note_and_the_host_hears_when_it_ends() {
     }
 
     // Modulating the strike position with the note-on strikes at the modulated point: the
-    // middle position alone has the 1320 Hz mode.
+    // middle position alone has the 1320 Hz mode. The bank's positions run from an end to the
+    // middle, so the position is a place along the whole bar: +0.5 moves from the end to the middle.
     let state = state_with(&two_position_bank());
     let strike = |modulate: bool| {
         let mut events = vec![
@@ -770,7 +771,7 @@ fn polyphonic_modulation_shapes_one_note_and_the_host_hears_when_it_ends() {
             (100, Send::NoteOn(69, 0, 7, 1.0)),
         ];
         if modulate {
-            events.push((100, Send::Mod("posx", 7, 1.0)));
+            events.push((100, Send::Mod("posx", 7, 0.5)));
         }
         let s = run(&Script {
             state: Some(&state),
@@ -1115,7 +1116,7 @@ fn a_broken_bank_loaded_while_playing_keeps_the_bank_and_the_state_holds_it() {
     );
     let saved = String::from_utf8_lossy(&s.state[8..]).into_owned();
     assert!(
-        saved.contains("\"state-format\":\"1\""),
+        saved.contains("\"state-format\":\"2\""),
         "no state format: {saved}"
     );
 }
