@@ -3,6 +3,8 @@
 //!
 //! # Lifecycle
 //! - [`Engine::new`] is cheap and allocates no voices.
+//! - [`Engine::reserve_voices`] says how many notes at once the voices are for (every voice
+//!   by default; a large bank gets only what the polyphony needs).
 //! - [`Engine::prepare`] sizes everything for a sample rate and allocates.
 //! - [`Engine::set_bank`] swaps the bank, reusing storage when it is large enough.
 //! - [`Engine::reset`] silences every voice without allocating.
@@ -49,8 +51,18 @@ const MAX_EXTRA_DAMPING: f64 = 20.0;
 /// Largest per-note tuning offset, in semitones.
 const MAX_EXPRESSION_SEMITONES: f32 = 48.0;
 
-/// Voices beyond the polyphony limit, used by stolen voices while they fade.
+/// Voices beyond the polyphony limit, used by stolen voices while they fade (fewer when fewer
+/// voices are allocated).
 const FADE_SLOTS: usize = 8;
+
+/// Heap the voices of an engine may take whatever polyphony was asked for: a bank small enough
+/// gets every voice, so raising the polyphony never reallocates; a larger one gets the voices
+/// the polyphony needs.
+const VOICE_MEMORY_ALLOWANCE: usize = 64 << 20;
+
+/// Heap a voice takes per mode of its bank, to within a few percent: its resonators (a slot and
+/// a ghost slot per mode) and its share of the pruner's per-voice analysis.
+const VOICE_BYTES_PER_MODE: usize = 288;
 
 /// How long a stolen voice fades, in seconds.
 const STEAL_FADE_S: f64 = 0.005;
@@ -73,6 +85,18 @@ const INPUT_GAIN_SMOOTHING_S: f64 = 0.01;
 
 /// Seed of the engine's random numbers (strike variation, noise), restored by `reset`.
 const SEED: u32 = 0x5EED_0001;
+
+/// Notes at once that voices are allocated for, for a bank of `num_modes` modes and `polyphony`
+/// asked: at least `polyphony`, and every voice that fits in [`VOICE_MEMORY_ALLOWANCE`] (fade
+/// slots and the input voice counted).
+fn voices_for(num_modes: usize, polyphony: usize) -> usize {
+    let fit = VOICE_MEMORY_ALLOWANCE / (VOICE_BYTES_PER_MODE * num_modes.max(1));
+    let affordable = (1..=MAX_POLYPHONY)
+        .rev()
+        .find(|&c| c + c.min(FADE_SLOTS) + 1 <= fit)
+        .unwrap_or(0);
+    polyphony.clamp(1, MAX_POLYPHONY).max(affordable)
+}
 
 /// Which note an event is about: a key on a MIDI channel, and the host's id for the note when it
 /// gives one (CLAP note ids).
@@ -307,8 +331,13 @@ pub struct Engine {
     kernel: Kernel,
     /// Sample rate in Hz.
     sample_rate_hz: f64,
-    /// Voice pool: `MAX_POLYPHONY + FADE_SLOTS` once prepared.
+    /// Voice pool once prepared: `capacity` voices and up to `FADE_SLOTS` more for stolen
+    /// voices while they fade.
     voices: Vec<Voice>,
+    /// Notes the voices can play at once: the polyphony control is held to it.
+    capacity: usize,
+    /// The polyphony voices are allocated for (see [`Engine::reserve_voices`]).
+    reserved_polyphony: usize,
     /// The voice driven by the audio input.
     input_voice: Option<Voice>,
     /// Whether the input voice has had non-silent input since the last control tick.
@@ -372,6 +401,8 @@ impl Engine {
             kernel: Kernel::from_env_or_detect(),
             sample_rate_hz: 48_000.0,
             voices: Vec::new(),
+            capacity: 0,
+            reserved_polyphony: MAX_POLYPHONY,
             input_voice: None,
             input_heard: false,
             input_dormant: true,
@@ -440,9 +471,30 @@ impl Engine {
         self.rebuild_decay_table();
     }
 
+    /// Allocates voices for up to `polyphony` notes at once (1 to [`MAX_POLYPHONY`]; the default
+    /// is every voice), or for more when the bank is small enough that more fit in 64 MiB. The
+    /// polyphony control plays at most [`Engine::voice_capacity`] notes. Allocates, and
+    /// silences every voice when the engine is already prepared: call it before
+    /// [`Engine::prepare`], off the audio thread.
+    pub fn reserve_voices(&mut self, polyphony: usize) {
+        self.reserved_polyphony = polyphony.clamp(1, MAX_POLYPHONY);
+        if !self.voices.is_empty()
+            && voices_for(self.bank.num_modes(), self.reserved_polyphony) != self.capacity
+        {
+            self.allocate_voices();
+            self.reset();
+        }
+    }
+
+    /// Notes the allocated voices can play at once (0 before [`Engine::prepare`]).
+    pub fn voice_capacity(&self) -> usize {
+        self.capacity
+    }
+
     fn allocate_voices(&mut self) {
         let n = self.bank.num_modes();
-        self.voices = (0..MAX_POLYPHONY + FADE_SLOTS)
+        self.capacity = voices_for(n, self.reserved_polyphony);
+        self.voices = (0..self.capacity + self.capacity.min(FADE_SLOTS))
             .map(|i| Voice::new(n, SEED ^ (i as u32 + 1)))
             .collect();
         self.input_voice = Some(Voice::new(n, SEED ^ 0xFFFF));

@@ -318,6 +318,7 @@ pub fn render_to<E>(
     let max_samples = (settings.max_seconds.max(0.0) * rate).round() as u64;
     let mut engine = Engine::new(Arc::clone(bank));
     engine.set_controls(&settings.controls);
+    engine.reserve_voices(settings.controls.polyphony);
     engine.prepare(settings.sample_rate_hz as f32, block);
 
     let mut events = schedule(notes, rate);

@@ -1501,6 +1501,51 @@ fn a_long_render_streams_to_disk_in_bounded_memory() {
 }
 
 #[test]
+fn a_bank_of_the_most_modes_renders_one_voice_in_bounded_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    // 65,536 modes from 100 Hz to 19.8 kHz: every voice of it takes about 19 MB, all 73 of
+    // them (polyphony, fade slots and the input voice) 1.4 GB.
+    let modes: Vec<(f64, f64, f64)> = (0..65_536)
+        .map(|i| (100.0 + 0.3 * i as f64, 5.0, 1.0))
+        .collect();
+    let mut bank = common::simple_bank(&modes);
+    bank.root_hz = Some(100.0);
+    std::fs::write(
+        dir.path().join("bank.json"),
+        serde_json::to_string(&bank).unwrap(),
+    )
+    .unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_modal-resonator"))
+        .current_dir(dir.path())
+        .args([
+            "render",
+            "bank.json",
+            "--notes",
+            "43:1@0",
+            "--set",
+            "polyphony=1",
+            "--max-seconds",
+            "0.05",
+            "-o",
+            "out.wav",
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let (status, peak_bytes) = wait_with_peak_memory(child);
+    assert!(status.success(), "{status}");
+    println!("a 65,536-mode bank at polyphony 1 rendered in {peak_bytes} bytes of memory at most");
+    assert!(
+        peak_bytes < 400_000_000,
+        "one voice of a 65,536-mode bank took {peak_bytes} bytes of memory"
+    );
+    let mut reader = hound::WavReader::open(dir.path().join("out.wav")).unwrap();
+    let samples: Vec<f32> = reader.samples::<i32>().map(|s| s.unwrap() as f32).collect();
+    assert!(samples.iter().any(|&x| x != 0.0), "the note is silent");
+}
+
+#[test]
 fn a_strike_setting_along_an_axis_the_bank_lacks_is_reported() {
     let dir = tempfile::tempdir().unwrap();
     let render = |set: &str| {

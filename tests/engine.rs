@@ -5,8 +5,10 @@ mod common;
 use common::*;
 use modal_resonator::dsp::coeffs::{db_to_gain, gain_to_db, midi_key_to_hz, t60_to_decay};
 use modal_resonator::engine::{
-    Controls, Note, NoteEvent, NoteExpression, VoiceModulation, CONTROL_PERIOD, TARGET_PEAK,
+    Controls, Engine, Note, NoteEvent, NoteExpression, PreparedBank, VoiceModulation,
+    CONTROL_PERIOD, MAX_POLYPHONY, TARGET_PEAK,
 };
+use std::sync::Arc;
 
 const RATE: f32 = 48_000.0;
 
@@ -179,6 +181,35 @@ fn restriking_a_ringing_key_adds_without_a_click() {
             .any(|(a, b)| (a - b).abs() > 1e-3),
         "re-strike reset the voice"
     );
+}
+
+#[test]
+fn a_large_bank_gets_the_voices_its_polyphony_needs_and_a_small_one_every_voice() {
+    let voices = |modes: usize, polyphony: usize| {
+        let mut e = Engine::new(Arc::new(PreparedBank::new(&dense_bank(modes, 55.0))));
+        e.reserve_voices(polyphony);
+        e.prepare(RATE, 512);
+        e
+    };
+    assert_eq!(voices(200, 2).voice_capacity(), MAX_POLYPHONY);
+    assert_eq!(voices(20_000, 64).voice_capacity(), MAX_POLYPHONY);
+    let mut e = voices(20_000, 2);
+    let capacity = e.voice_capacity();
+    assert!((2..MAX_POLYPHONY / 4).contains(&capacity), "{capacity}");
+    // The polyphony control asks for more than was reserved: the voices there play.
+    let mut c = e.controls().clone();
+    c.polyphony = MAX_POLYPHONY;
+    e.set_controls(&c);
+    let chord: Vec<NoteEvent> = (0..MAX_POLYPHONY as u8)
+        .map(|k| on(0, 30 + k, 1.0))
+        .collect();
+    render(&mut e, &chord, 0.003, 256);
+    assert_eq!(e.stats().voices, capacity);
+    // Reserving more reallocates.
+    e.reserve_voices(MAX_POLYPHONY);
+    assert_eq!(e.voice_capacity(), MAX_POLYPHONY);
+    render(&mut e, &chord, 0.003, 256);
+    assert_eq!(e.stats().voices, MAX_POLYPHONY);
 }
 
 #[test]

@@ -217,7 +217,8 @@ impl Engine {
             }
         }
         // Polyphony lowered: fade the quietest voices beyond the limit.
-        while self.voices.iter().filter(|v| v.is_sounding()).count() > self.controls.polyphony {
+        let polyphony = self.controls.polyphony.min(self.capacity);
+        while self.voices.iter().filter(|v| v.is_sounding()).count() > polyphony {
             let victim = self.quietest_sounding();
             self.voices[victim].state = VoiceState::Fading;
         }
@@ -331,21 +332,23 @@ impl Engine {
         {
             return i;
         }
-        if self.voices.iter().filter(|v| v.is_sounding()).count() >= self.controls.polyphony {
+        let polyphony = self.controls.polyphony.min(self.capacity);
+        if self.voices.iter().filter(|v| v.is_sounding()).count() >= polyphony {
             let victim = self.quietest_sounding();
             self.voices[victim].state = VoiceState::Fading;
         }
         if let Some(i) = self.voices.iter().position(|v| v.state == VoiceState::Free) {
             return i;
         }
-        // Every slot is fading: reuse the one closest to silence.
+        // Every other slot is fading: reuse the fading one closest to silence.
         let i = (0..self.voices.len())
+            .filter(|&i| self.voices[i].state == VoiceState::Fading)
             .min_by(|&a, &b| {
                 self.voices[a]
                     .fade_gain
                     .total_cmp(&self.voices[b].fade_gain)
             })
-            .expect("voices are allocated");
+            .unwrap_or_else(|| self.quietest_sounding());
         end_voice(&mut self.voices[i], &mut self.ended, self.block_pos);
         i
     }

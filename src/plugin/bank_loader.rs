@@ -28,10 +28,17 @@ pub fn bank_from_state(json: &str) -> Result<Bank, String> {
     parse_bank_str(json, "saved bank").map_err(|e| e.to_string())
 }
 
-/// An engine playing `bank`, prepared for `sample_rate_hz` and blocks of up to `max_block`.
-/// Allocates: never call it on the audio thread.
-pub fn build_engine(bank: &Bank, sample_rate_hz: f32, max_block: usize) -> Box<Engine> {
+/// An engine playing `bank` with voices for `polyphony` notes at once, prepared for
+/// `sample_rate_hz` and blocks of up to `max_block`. Allocates: never call it on the audio
+/// thread.
+pub fn build_engine(
+    bank: &Bank,
+    polyphony: usize,
+    sample_rate_hz: f32,
+    max_block: usize,
+) -> Box<Engine> {
     let mut engine = Box::new(Engine::new(Arc::new(PreparedBank::new(bank))));
+    engine.reserve_voices(polyphony);
     engine.prepare(sample_rate_hz, max_block);
     engine
 }

@@ -5,7 +5,7 @@
 use crossbeam_channel::{Receiver, Sender};
 
 use super::bank_loader::LoadedEngine;
-use crate::engine::{Engine, Note};
+use crate::engine::{Engine, Note, MAX_POLYPHONY};
 
 /// Engines handed to the background thread at once, before one waits for room.
 const TRASH_CAPACITY: usize = 8;
@@ -52,6 +52,8 @@ pub struct Engines {
     pub requested_generation: u64,
     /// The bank generation of the engine playing.
     pub playing_generation: u64,
+    /// The polyphony the last request was made at.
+    requested_polyphony: usize,
     /// Incremented on every activation: engines built for an earlier one are not used.
     pub epoch: u64,
     /// Blocks since the requested bank was last asked for.
@@ -71,6 +73,7 @@ impl Engines {
             waiting: Default::default(),
             requested_generation: 0,
             playing_generation: 0,
+            requested_polyphony: 0,
             epoch: 0,
             blocks_waiting: 0,
         };
@@ -91,19 +94,37 @@ impl Engines {
         self.epoch += 1;
         self.requested_generation = generation;
         self.playing_generation = generation;
+        self.requested_polyphony = 0;
         while self.loaded_rx.try_recv().is_ok() {}
     }
 
-    /// The bank generation to ask the background thread for, if any: a new one, or one asked
-    /// for long ago that has not arrived (and did not fail to load, per `failed_generation`).
-    /// Call once per block.
-    pub fn request(&mut self, generation: u64, failed_generation: u64) -> Option<u64> {
+    /// The bank generation to ask the background thread for, if any: a new one, one asked for
+    /// long ago that has not arrived (and did not fail to load, per `failed_generation`), or the
+    /// one playing again when `polyphony` outgrows its voices (the background thread builds
+    /// engines with voices for the polyphony set then). Call once per block.
+    pub fn request(
+        &mut self,
+        generation: u64,
+        failed_generation: u64,
+        polyphony: usize,
+    ) -> Option<u64> {
         if generation != self.requested_generation {
             self.requested_generation = generation;
+            self.requested_polyphony = polyphony;
             self.blocks_waiting = 0;
             return Some(generation);
         }
-        if self.playing_generation == generation || failed_generation == generation {
+        let outgrown = self
+            .current
+            .as_ref()
+            .is_some_and(|e| e.voice_capacity() < polyphony.min(MAX_POLYPHONY));
+        if outgrown && self.requested_polyphony < polyphony {
+            self.requested_polyphony = polyphony;
+            self.blocks_waiting = 0;
+            return Some(generation);
+        }
+        let arrived = self.playing_generation == generation && !outgrown;
+        if arrived || failed_generation == generation {
             return None;
         }
         self.blocks_waiting += 1;
@@ -198,5 +219,61 @@ impl Engines {
             }
         }
         sent
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use super::*;
+    use crate::engine::PreparedBank;
+    use crate::model::{Bank, Mode, Position};
+
+    /// An engine playing a bank of `modes` modes, with voices reserved for `polyphony`.
+    fn engine(modes: usize, polyphony: usize) -> Box<Engine> {
+        let mut bank = Bank::new(
+            "large",
+            vec![Position {
+                name: "a".into(),
+                coords: vec![0.0],
+            }],
+        );
+        bank.modes = (0..modes)
+            .map(|i| Mode {
+                freq_hz: 100.0 + i as f64,
+                decay_per_s: 3.0,
+                gains: vec![1.0],
+            })
+            .collect();
+        let mut e = Box::new(Engine::new(Arc::new(PreparedBank::new(&bank))));
+        e.reserve_voices(polyphony);
+        e.prepare(48_000.0, 64);
+        e
+    }
+
+    #[test]
+    fn the_bank_playing_is_asked_for_again_when_the_polyphony_outgrows_its_voices() {
+        let (mut engines, _background) = Engines::new();
+        engines.activate(engine(20_000, 2), 1);
+        let capacity = engines.current.as_ref().unwrap().voice_capacity();
+        assert!(capacity < MAX_POLYPHONY, "{capacity}");
+        // Within the voices: nothing to ask.
+        assert_eq!(engines.request(1, 0, capacity), None);
+        // Beyond them: the same bank once, not on every block while it is built.
+        assert_eq!(engines.request(1, 0, capacity + 1), Some(1));
+        assert_eq!(engines.request(1, 0, capacity + 1), None);
+        // Higher still: asked again, for the new polyphony.
+        assert_eq!(engines.request(1, 0, MAX_POLYPHONY), Some(1));
+        // A lost request is repeated.
+        let repeats = (0..RETRY_BLOCKS).filter_map(|_| engines.request(1, 0, MAX_POLYPHONY));
+        assert_eq!(repeats.count(), 1);
+
+        // A small bank has every voice: no polyphony needs a rebuild.
+        let (mut engines, _background) = Engines::new();
+        engines.activate(engine(100, 2), 1);
+        for polyphony in [1, 16, MAX_POLYPHONY, 1_000] {
+            assert_eq!(engines.request(1, 0, polyphony), None, "{polyphony}");
+        }
     }
 }

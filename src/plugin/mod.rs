@@ -391,7 +391,8 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
                 Ok(bank) => {
                     let rate = f32::from_bits(shared.sample_rate_bits.load(Ordering::Acquire));
                     let max_block = shared.max_block.load(Ordering::Acquire) as usize;
-                    let engine = build_engine(&bank, rate, max_block);
+                    let polyphony = params.voices.polyphony.value().max(1) as usize;
+                    let engine = build_engine(&bank, polyphony, rate, max_block);
                     set_error(&shared, None);
                     if let Ok(mut playing) = shared.playing_json.write() {
                         *playing = json;
@@ -475,7 +476,8 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
                 }
             }
         };
-        let mut engine = build_engine(&bank, rate, max_block);
+        let polyphony = self.params.voices.polyphony.value().max(1) as usize;
+        let mut engine = build_engine(&bank, polyphony, rate, max_block);
         engine.set_last_key(self.last_key);
         self.engines.activate(engine, generation);
         true
@@ -507,7 +509,8 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         let started = self.editor_state.is_open().then(Instant::now);
         let generation = self.params.bank.generation.load(Ordering::Acquire);
         let failed = self.shared.failed_generation.load(Ordering::Acquire);
-        if let Some(generation) = self.engines.request(generation, failed) {
+        let polyphony = self.params.voices.polyphony.value().max(1) as usize;
+        if let Some(generation) = self.engines.request(generation, failed, polyphony) {
             let epoch = self.engines.epoch;
             context.execute_background(Task::LoadBank { generation, epoch });
         }
