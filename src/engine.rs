@@ -93,7 +93,7 @@ fn voices_for(num_modes: usize, polyphony: usize) -> usize {
     let fit = VOICE_MEMORY_ALLOWANCE / (VOICE_BYTES_PER_MODE * num_modes.max(1));
     let affordable = (1..=MAX_POLYPHONY)
         .rev()
-        .find(|&c| c + c.min(FADE_SLOTS) + 1 <= fit)
+        .find(|&c| c + c.min(FADE_SLOTS) < fit)
         .unwrap_or(0);
     polyphony.clamp(1, MAX_POLYPHONY).max(affordable)
 }

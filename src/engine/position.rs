@@ -95,7 +95,7 @@ impl PositionMap {
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
                     (lo.min(v), hi.max(v))
                 });
-            axes[axis] = if !(hi > lo) {
+            axes[axis] = if hi <= lo {
                 StrikeAxis::Fixed
             } else if lo >= 0.0 && hi <= 0.5 {
                 StrikeAxis::Mirrored
