@@ -8,6 +8,7 @@ use modal_resonator::engine::{
     Controls, Engine, Note, NoteEvent, NoteExpression, PreparedBank, VoiceModulation,
     CONTROL_PERIOD, MAX_POLYPHONY, TARGET_PEAK,
 };
+use modal_resonator::model::{Bank, BankDefaults, Mode};
 use std::sync::Arc;
 
 const RATE: f32 = 48_000.0;
@@ -117,6 +118,37 @@ fn the_lowest_mode_a_bank_may_hold_keeps_the_strike_level() {
             && problems[0].contains("from 1 to"),
         "{problems:?}"
     );
+}
+
+#[test]
+fn a_default_strike_peaks_near_minus_6_dbfs_wherever_the_bank_strikes_and_however_late() {
+    let peak_db = |bank: &Bank, key: u8, seconds: f64| {
+        let mut e = engine(bank, RATE);
+        let (l, r) = render(&mut e, &[on(0, key, 1.0)], seconds, 4096);
+        gain_to_db(peak(&l).max(peak(&r)))
+    };
+    let target = gain_to_db(TARGET_PEAK);
+    // Struck by default at its second position, where the mode is a million times louder
+    // than at the first.
+    let mut bank = Bank::new("two ends", two_ends());
+    bank.modes = vec![Mode {
+        freq_hz: 440.0,
+        decay_per_s: 3.0,
+        gains: vec![1e-6, 1.0],
+    }];
+    bank.root_hz = Some(440.0);
+    bank.defaults = Some(BankDefaults {
+        strike_position: Some(1.0),
+        ..BankDefaults::default()
+    });
+    let got = peak_db(&bank, 69, 1.0);
+    assert!((got - target).abs() <= 1.0, "{got} dBFS at the default position");
+    // Two modes 0.01 Hz apart, opposite in sign: they cancel at the strike and drift into
+    // phase over the next 40 s, while they barely decay.
+    let mut bank = simple_bank(&[(1000.0, 0.01, 1.0), (1000.01, 0.01, -1.0)]);
+    bank.root_hz = Some(1000.0);
+    let got = peak_db(&bank, 83, 60.0);
+    assert!((got - target).abs() <= 1.0, "{got} dBFS for modes drifting into phase");
 }
 
 #[test]

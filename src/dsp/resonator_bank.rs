@@ -205,6 +205,16 @@ impl ResonatorBank {
         self.slot_of_mode[mode] != NONE || self.dormant_of_mode[mode] != NONE
     }
 
+    /// Each column's sum of its computed modes' amplitudes `|z|` (ghosts included): undriven,
+    /// no later sample of the column can exceed it, since every mode decays.
+    pub fn column_amplitudes(&self) -> [f32; COLUMNS] {
+        let mut sum = [0.0f32; COLUMNS];
+        for slot in self.live_slots() {
+            sum[slot % COLUMNS] += self.re[slot].hypot(self.im[slot]);
+        }
+        sum
+    }
+
     /// The phasor state `(re, im)` of a mode's slot, or `None` when it is not computed.
     pub fn state(&self, mode: usize) -> Option<(f32, f32)> {
         let slot = self.slot_of_mode[mode];

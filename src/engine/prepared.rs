@@ -10,8 +10,8 @@ use crate::dsp::coeffs::{hz_to_midi_key, ModeCoeffs, MIN_DECAY_PER_S};
 use crate::dsp::{Exciter, Kernel, ResonatorBank, COLUMNS};
 use crate::model::Bank;
 
-/// Peak of a full-velocity strike at the bank's first position, with its default controls:
-/// -6 dBFS.
+/// Peak of a full-velocity strike with the bank's default controls (its default strike
+/// position included): -6 dBFS.
 pub const TARGET_PEAK: f32 = 0.5;
 
 /// Sample rate of the loudness measurement; level does not depend on the rate.
@@ -59,6 +59,21 @@ pub struct PreparedBank {
     pub column_pan: [f32; COLUMNS],
 }
 
+/// A default strike's modes after [`PreparedBank::render_default_strike`], to render further.
+struct Ringing {
+    bank: ResonatorBank,
+    kernel: Kernel,
+    /// Mode-samples computed so far.
+    spent: usize,
+}
+
+/// Samples the default strike is rendered in at a time.
+const RUN: usize = 256;
+
+/// Most mode-samples spent following a default strike for its peak: 10 s of 200 modes, or
+/// 0.2 s of 10,000.
+const PEAK_MODE_SAMPLES: f64 = 1e8;
+
 impl PreparedBank {
     /// Prepares `bank` (which should have passed validation). Allocates and renders a short
     /// strike to measure the level.
@@ -95,7 +110,7 @@ impl PreparedBank {
             normalization: 1.0,
             column_pan: COLUMN_PAN,
         };
-        let (frames, peak_len) = prepared.render_default_strike();
+        let (frames, mut ringing) = prepared.render_default_strike();
         let mut cov = [[0.0f64; COLUMNS]; COLUMNS];
         for frame in &frames {
             for (row, &x) in cov.iter_mut().zip(frame) {
@@ -105,7 +120,7 @@ impl PreparedBank {
             }
         }
         prepared.column_pan = balanced_pans(&cov);
-        let peak = prepared.default_peak(&frames[..peak_len]);
+        let peak = prepared.default_peak(&frames, &mut ringing);
         if peak > 0.0 && peak.is_finite() {
             prepared.normalization = TARGET_PEAK / peak;
             for g in &mut prepared.gains {
@@ -174,16 +189,17 @@ impl PreparedBank {
             .max(MIN_DECAY_PER_S)
     }
 
-    /// Each column's output of a full-velocity strike at the first position with the bank's
-    /// other default controls (material, exciter, hardness) at the root pitch, before
+    /// Each column's output of a full-velocity strike with the bank's default controls (strike
+    /// position, material, exciter, hardness) at the root pitch, before
     /// normalisation, at `MEASURE_RATE_HZ`: `BALANCE_S` of it, or less for a bank of so many
-    /// modes that this would cost more than `BALANCE_MODE_SAMPLES`, and never less than the
-    /// first part, whose length is returned beside, where the peak is measured.
-    fn render_default_strike(&self) -> (Vec<[f32; COLUMNS]>, usize) {
+    /// modes that this would cost more than `BALANCE_MODE_SAMPLES`, but never less than
+    /// the first 0.2 to 1 s (more for low modes, to let their beating build up); and the modes
+    /// still ringing at its end.
+    fn render_default_strike(&self) -> (Vec<[f32; COLUMNS]>, Ringing) {
         let controls = Controls::for_bank(&self.source);
         let n = self.num_modes();
         let mut bank = ResonatorBank::new(n);
-        let w = PositionWeights::single(0);
+        let w = self.positions.weights(controls.strike_x, controls.strike_y);
         let theta_max = TAU * crate::dsp::coeffs::MAX_FREQ_RATIO;
         let log_damping = self.log_damping(controls.material_q);
         for m in 0..n {
@@ -207,29 +223,57 @@ impl PreparedBank {
         let affordable_s = BALANCE_MODE_SAMPLES / (n.max(1) as f64 * MEASURE_RATE_HZ);
         let seconds = affordable_s.min(BALANCE_S).max(peak_s);
         let total = (seconds * MEASURE_RATE_HZ) as usize;
-        const RUN: usize = 256;
         let mut frames = vec![[0.0f32; COLUMNS]; total.div_ceil(RUN) * RUN];
-        let peak_len = ((peak_s * MEASURE_RATE_HZ) as usize).min(frames.len());
         let mut input = vec![0.0f32; RUN];
         let kernel = Kernel::from_env_or_detect();
         for run in frames.chunks_mut(RUN) {
             let driven = exciter.render(&mut input);
             bank.process(kernel, driven.then_some(&input[..]), run);
         }
-        (frames, peak_len)
+        let spent = frames.len() * bank.num_active();
+        (
+            frames,
+            Ringing {
+                bank,
+                kernel,
+                spent,
+            },
+        )
     }
 
-    /// Peak of either channel of `frames` ([`Self::render_default_strike`]) at the bank's
-    /// default width with its column pans.
-    fn default_peak(&self, frames: &[[f32; COLUMNS]]) -> f32 {
+    /// Peak of either channel of a default strike at the bank's default width with its column
+    /// pans: of `frames` ([`Self::render_default_strike`]), and of the rest of the strike while
+    /// the modes still `ringing` could sum to more than that (modes that cancel at first and
+    /// drift into phase later), as long as `PEAK_MODE_SAMPLES` allow.
+    fn default_peak(&self, frames: &[[f32; COLUMNS]], ringing: &mut Ringing) -> f32 {
         let width = Controls::for_bank(&self.source).width;
         let (wl, wr) = lane_weights(width, &self.column_pan);
-        let mut peak = 0.0f32;
-        for a in frames {
-            let l: f32 = a.iter().zip(&wl).map(|(x, w)| x * w).sum();
-            let r: f32 = a.iter().zip(&wr).map(|(x, w)| x * w).sum();
-            peak = peak.max(l.abs()).max(r.abs());
+        let peak_of = |frames: &[[f32; COLUMNS]]| {
+            let mut peak = 0.0f32;
+            for a in frames {
+                let l: f32 = a.iter().zip(&wl).map(|(x, w)| x * w).sum();
+                let r: f32 = a.iter().zip(&wr).map(|(x, w)| x * w).sum();
+                peak = peak.max(l.abs()).max(r.abs());
+            }
+            peak
+        };
+        let mut peak = peak_of(frames);
+        let step = (0.1 * MEASURE_RATE_HZ) as usize / RUN * RUN;
+        let cost = step * ringing.bank.num_active();
+        let mut run = vec![[0.0f32; COLUMNS]; RUN];
+        loop {
+            let a = ringing.bank.column_amplitudes();
+            let dot = |w: &[f32; COLUMNS]| a.iter().zip(w).map(|(x, w)| x * w).sum::<f32>();
+            let bound = dot(&wl).max(dot(&wr));
+            if !(bound > peak) || (ringing.spent + cost) as f64 > PEAK_MODE_SAMPLES {
+                return peak;
+            }
+            for _ in 0..step / RUN {
+                run.fill([0.0; COLUMNS]);
+                ringing.bank.process(ringing.kernel, None, &mut run);
+                peak = peak.max(peak_of(&run));
+            }
+            ringing.spent += cost;
         }
-        peak
     }
 }

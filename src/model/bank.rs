@@ -98,7 +98,8 @@ pub struct BankDefaults {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schemars(range(min = 0.05, max = 20))]
     pub hardness_ms: Option<f64>,
-    /// Strike position along the bank's positions, 0 to 1.
+    /// Where the bank is struck by default: a place on the object, 0 to 1 along the first axis
+    /// of its positions (see the presets README).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schemars(range(min = 0, max = 1))]
     pub strike_position: Option<f64>,
