@@ -1107,6 +1107,32 @@ fn shape_refuses_bad_names_and_dimensions_cleanly() {
         ],
     );
     assert_failed_cleanly(&out, &["positions[0]", "[0, 1]"], dir.path(), &[]);
+    // Objects the theory cannot make: a bar thicker than long, a bar wider than long, a bar so
+    // long and a bell so large that their lowest modes fall below the 1 Hz floor of a bank.
+    for (args, expected) in [
+        (
+            &["free-free-bar", "--length", "0.01", "--thickness", "0.5"][..],
+            &["thickness_m = 0.5", "a fifth of the length"][..],
+        ),
+        (
+            &["free-free-bar", "--length", "0.1", "--width", "0.5"][..],
+            &["width_m = 0.5", "a plate"][..],
+        ),
+        (
+            &["free-free-bar", "--length", "30"][..],
+            &["lowest mode would be at", "below the 1 Hz", "--tune-hz"][..],
+        ),
+        (
+            &["bell", "--diameter", "40"][..],
+            &["lowest mode would be at", "below the 1 Hz"][..],
+        ),
+    ] {
+        let mut command = vec!["shape"];
+        command.extend(args);
+        command.extend(["-o", "x.json"]);
+        let out = run(dir.path(), &command);
+        assert_failed_cleanly(&out, expected, dir.path(), &[]);
+    }
     let help = run(dir.path(), &["shape", "--help"]);
     let text = stdout(&help);
     for word in [

@@ -142,13 +142,19 @@ fn a_default_strike_peaks_near_minus_6_dbfs_wherever_the_bank_strikes_and_howeve
         ..BankDefaults::default()
     });
     let got = peak_db(&bank, 69, 1.0);
-    assert!((got - target).abs() <= 1.0, "{got} dBFS at the default position");
+    assert!(
+        (got - target).abs() <= 1.0,
+        "{got} dBFS at the default position"
+    );
     // Two modes 0.01 Hz apart, opposite in sign: they cancel at the strike and drift into
     // phase over the next 40 s, while they barely decay.
     let mut bank = simple_bank(&[(1000.0, 0.01, 1.0), (1000.01, 0.01, -1.0)]);
     bank.root_hz = Some(1000.0);
     let got = peak_db(&bank, 83, 60.0);
-    assert!((got - target).abs() <= 1.0, "{got} dBFS for modes drifting into phase");
+    assert!(
+        (got - target).abs() <= 1.0,
+        "{got} dBFS for modes drifting into phase"
+    );
 }
 
 #[test]

@@ -119,7 +119,19 @@ impl Bar {
     pub(super) fn validate(&self) -> Result<(), ShapeError> {
         super::check_positive("length_m", self.length_m)?;
         super::check_positive("width_m", self.width_m)?;
-        super::check_positive("thickness_m", self.thickness_m)
+        super::check_positive("thickness_m", self.thickness_m)?;
+        super::check_thin("thickness_m", self.thickness_m, self.length_m, "length")?;
+        if self.width_m > self.length_m {
+            return Err(ShapeError::BadParameter {
+                name: "width_m",
+                value: self.width_m,
+                reason: format!(
+                    "wider than the bar is long ({} m): that is a plate",
+                    self.length_m
+                ),
+            });
+        }
+        Ok(())
     }
 
     /// Free-free modes up to the limits, shapes at `coords` (fractions of the length).

@@ -107,6 +107,13 @@ pub enum ShapeError {
         /// The limit in Hz.
         max_freq_hz: f64,
     },
+    /// The object's lowest mode lies below the lowest frequency a bank's modes may have.
+    BelowFloor {
+        /// The lowest mode in Hz.
+        lowest_hz: f64,
+        /// The floor in Hz.
+        min_freq_hz: f64,
+    },
 }
 
 impl fmt::Display for ShapeError {
@@ -123,7 +130,25 @@ impl fmt::Display for ShapeError {
                 reason,
             } => write!(f, "positions[{index}] (\"{name}\"): {reason}"),
             Self::CannotTune { reason } => write!(f, "cannot tune: {reason}"),
-            Self::NoModes { max_freq_hz } => write!(f, "no mode below {max_freq_hz} Hz"),
+            Self::NoModes { max_freq_hz } => write!(
+                f,
+                "no mode below {max_freq_hz} Hz: the object is too small or too stiff to sound \
+                 within it"
+            ),
+            Self::BelowFloor {
+                lowest_hz,
+                min_freq_hz,
+            } => write!(
+                f,
+                "the object's lowest mode would be at {} Hz, below the \
+                 {min_freq_hz} Hz a bank's modes start at: make it smaller, thicker, stiffer or \
+                 tighter (or tune it with --tune-hz)",
+                if *lowest_hz >= 0.01 {
+                    format!("{lowest_hz:.3}")
+                } else {
+                    format!("{lowest_hz:.1e}")
+                }
+            ),
         }
     }
 }
@@ -138,6 +163,28 @@ pub(crate) struct ShapedMode {
     pub freq_hz: f64,
     /// Mode shape at each strike position.
     pub shape: Vec<f64>,
+}
+
+/// `Ok` when `thickness` (named `name`) is at most a fifth of `span` (what `what` is measured
+/// against): thicker, the object is a block and the thin-object theory of its modes fails.
+pub(crate) fn check_thin(
+    name: &'static str,
+    thickness: f64,
+    span: f64,
+    what: &str,
+) -> Result<(), ShapeError> {
+    if thickness <= 0.2 * span {
+        Ok(())
+    } else {
+        Err(ShapeError::BadParameter {
+            name,
+            value: thickness,
+            reason: format!(
+                "more than a fifth of the {what} ({span} m): the object is too thick for the \
+                 thin-object theory its modes come from"
+            ),
+        })
+    }
 }
 
 /// `Ok` when `value` is a positive finite number.
@@ -162,6 +209,16 @@ pub(crate) fn finish_modes(
     limits: &ModeLimits,
 ) -> Result<Vec<Mode>, ShapeError> {
     let min_hz = crate::model::validate::MODE_FREQ_HZ.min;
+    let lowest_hz = shaped
+        .iter()
+        .map(|m| m.freq_hz)
+        .fold(f64::INFINITY, f64::min);
+    if lowest_hz < min_hz {
+        return Err(ShapeError::BelowFloor {
+            lowest_hz,
+            min_freq_hz: min_hz,
+        });
+    }
     shaped.retain(|mode| mode.freq_hz >= min_hz && mode.freq_hz < limits.max_freq_hz);
     shaped.sort_by(|a, b| a.freq_hz.total_cmp(&b.freq_hz));
     shaped.truncate(limits.max_modes);
