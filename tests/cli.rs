@@ -779,6 +779,30 @@ fn write_strike_wav(path: &Path, channels: u16) {
 }
 
 #[test]
+fn banks_go_to_standard_output_for_a_dash() {
+    let dir = dir_with_bank();
+    write_strike_wav(&dir.path().join("strike.wav"), 1);
+    for args in [
+        &["shape", "free-free-bar", "-o", "-"][..],
+        &["compress", "bank.json", "-o", "-"][..],
+        &["fit", "strike.wav", "--modes", "4", "-o", "-"][..],
+    ] {
+        let out = run(dir.path(), args);
+        assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+        // Standard output holds the bank alone; the summary goes to standard error.
+        let bank = modal_resonator::model::parse_bank_str(&stdout(&out), "stdout")
+            .unwrap_or_else(|e| panic!("{args:?}: {e}"));
+        assert!(!bank.modes.is_empty(), "{args:?}");
+        assert!(
+            stderr(&out).contains("standard output:"),
+            "{args:?}: {}",
+            stderr(&out)
+        );
+        assert_eq!(entries(dir.path()), ["bank.json", "strike.wav"], "{args:?}");
+    }
+}
+
+#[test]
 fn fit_writes_a_bank_and_a_report_from_recordings() {
     let dir = dir_with_bank();
     write_strike_wav(&dir.path().join("edge.wav"), 1);

@@ -6,9 +6,8 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 
 use modal_resonator::model::compress::{compress_bank, CompressOptions, DEFAULT_DROP_BELOW_DB};
-use modal_resonator::model::save_bank_file;
 
-use super::{check_output_dir, load_bank, same_file};
+use super::{check_output_dir, load_bank, output_name, same_file, save_bank_output, say};
 
 /// Arguments of `compress`.
 #[derive(Debug, Args)]
@@ -46,13 +45,16 @@ pub(super) fn run(args: &CompressArgs) -> Result<(), String> {
         drop_below_db: (!args.keep_weak).then_some(args.drop_below_db),
     };
     let (compressed, report) = compress_bank(&bank, &options).map_err(|e| e.to_string())?;
-    save_bank_file(&compressed, &args.output).map_err(|e| e.to_string())?;
-    println!("{report}");
-    println!(
-        "{}: {} modes, {} positions",
-        args.output.display(),
-        compressed.modes.len(),
-        compressed.positions.len()
+    save_bank_output(&compressed, &args.output)?;
+    say(&args.output, &report.to_string());
+    say(
+        &args.output,
+        &format!(
+            "{}: {} modes, {} positions",
+            output_name(&args.output),
+            compressed.modes.len(),
+            compressed.positions.len()
+        ),
     );
     Ok(())
 }

@@ -9,8 +9,10 @@ use modal_resonator::model::fit::{
 };
 use modal_resonator::model::{commit_all, stage_bank_file};
 
+use modal_resonator::model::validate::validate_bank;
+
 use super::progress::Progress;
-use super::{check_output_dir, same_file};
+use super::{check_output_dir, is_stdout, output_name, same_file, save_bank_output, say};
 
 /// Arguments of `fit`.
 #[derive(Debug, Args)]
@@ -86,11 +88,10 @@ pub(super) fn run(args: &FitArgs) -> Result<(), String> {
         recordings.push(read_wav_recording(&path, &position).map_err(|e| e.to_string())?);
     }
     let name = args.name.clone().unwrap_or_else(|| {
-        args.output
-            .file_stem()
-            .map_or("Fitted bank".to_string(), |s| {
-                s.to_string_lossy().into_owned()
-            })
+        let stem = args.output.file_stem().filter(|_| !is_stdout(&args.output));
+        stem.map_or("Fitted bank".to_string(), |s| {
+            s.to_string_lossy().into_owned()
+        })
     });
     let options = FitOptions {
         name,
@@ -110,22 +111,33 @@ pub(super) fn run(args: &FitArgs) -> Result<(), String> {
     let cannot_write = |path: &std::path::Path, e: std::io::Error| {
         format!("{}: cannot write: {e}", path.display())
     };
-    let mut files = vec![stage_bank_file(&fit.bank, &args.output).map_err(|e| e.to_string())?];
+    let mut files = Vec::new();
+    if !is_stdout(&args.output) {
+        files.push(stage_bank_file(&fit.bank, &args.output).map_err(|e| e.to_string())?);
+    } else if let Some(problem) = validate_bank(&fit.bank).first() {
+        return Err(format!("the fitted bank is not valid: {problem}"));
+    }
     if let Some(path) = &args.report {
         files.push(stage_report_file(&fit.report, path).map_err(|e| cannot_write(path, e))?);
     }
     commit_all(files).map_err(|(path, e)| cannot_write(&path, e))?;
-    print!("{}", fit.report);
+    if is_stdout(&args.output) {
+        save_bank_output(&fit.bank, &args.output)?;
+    }
+    say(&args.output, fit.report.to_string().trim_end());
     for r in &fit.report.recordings {
         for w in &r.warnings {
             eprintln!("warning: {}: {w}", r.name);
         }
     }
-    println!(
-        "{}: {} modes, {} positions",
-        args.output.display(),
-        fit.bank.modes.len(),
-        fit.bank.positions.len()
+    say(
+        &args.output,
+        &format!(
+            "{}: {} modes, {} positions",
+            output_name(&args.output),
+            fit.bank.modes.len(),
+            fit.bank.positions.len()
+        ),
     );
     Ok(())
 }

@@ -153,10 +153,59 @@ pub(super) fn load_bank(arg: &str) -> Result<Bank, String> {
 /// The output path that means standard output.
 pub(super) const STDOUT: &str = "-";
 
+/// Whether `output` means standard output.
+pub(super) fn is_stdout(output: &Path) -> bool {
+    output.as_os_str() == STDOUT
+}
+
+/// Writes `bank` to `output`: a file, atomically, or standard output for `-`. Validated first
+/// either way; nothing is written when it fails.
+pub(super) fn save_bank_output(bank: &Bank, output: &Path) -> Result<(), String> {
+    if !is_stdout(output) {
+        return modal_resonator::model::save_bank_file(bank, output).map_err(|e| e.to_string());
+    }
+    let problems = modal_resonator::model::validate::validate_bank(bank);
+    if let Some(first) = problems.first() {
+        return Err(format!(
+            "standard output: the bank is not valid ({} problems), first: {first}",
+            problems.len()
+        ));
+    }
+    use std::io::Write;
+    let json = modal_resonator::model::io::bank_to_json(bank);
+    let mut stdout = std::io::stdout().lock();
+    stdout
+        .write_all(json.as_bytes())
+        .and_then(|()| stdout.flush())
+        .map_err(|e| format!("standard output: {e}"))
+}
+
+/// Prints a line of a command's summary: on standard output, or on standard error when the
+/// command's output goes to standard output.
+pub(super) fn say(output: &Path, line: &str) {
+    if is_stdout(output) {
+        eprintln!("{line}");
+    } else {
+        println!("{line}");
+    }
+}
+
+/// How a summary names `output`.
+pub(super) fn output_name(output: &Path) -> String {
+    if is_stdout(output) {
+        "standard output".to_string()
+    } else {
+        output.display().to_string()
+    }
+}
+
 /// Fails early, before a long render, when the output cannot be written: something other than
 /// a regular file is there (a directory, a device, a named pipe, a socket; a symbolic link is
 /// followed), or its directory does not exist.
 pub(super) fn check_output_dir(output: &Path) -> Result<(), String> {
+    if is_stdout(output) {
+        return Ok(());
+    }
     let target = destination(output).map_err(|e| {
         format!(
             "{}: {e}; name a file to write{}",
@@ -179,6 +228,9 @@ pub(super) fn check_output_dir(output: &Path) -> Result<(), String> {
 /// inode, so a hard or symbolic link to it is the same file), one still to be written by where
 /// its path leads.
 pub(super) fn same_file(a: &Path, b: &Path) -> bool {
+    if is_stdout(a) || is_stdout(b) {
+        return false;
+    }
     #[cfg(unix)]
     if let (Ok(x), Ok(y)) = (std::fs::metadata(a), std::fs::metadata(b)) {
         use std::os::unix::fs::MetadataExt;

@@ -11,9 +11,9 @@ use modal_resonator::model::shapes::{
     DEFAULT_MAX_MODES, MAX_AUDIBLE_HZ, OBJECTS,
 };
 use modal_resonator::model::summary::{note_name, note_to_midi_key};
-use modal_resonator::model::{save_bank_file, Position};
+use modal_resonator::model::Position;
 
-use super::check_output_dir;
+use super::{check_output_dir, output_name, save_bank_output, say};
 
 /// Arguments of `shape`.
 #[derive(Debug, Args)]
@@ -133,7 +133,7 @@ pub(super) fn run(args: &ShapeArgs) -> Result<(), String> {
         bank.author = args.author.clone();
     }
     bank.license = args.license.clone();
-    save_bank_file(&bank, &args.output).map_err(|e| e.to_string())?;
+    save_bank_output(&bank, &args.output)?;
 
     let root_hz = bank.effective_root_hz();
     let (lo, hi) = bank.modes.iter().fold((f64::MAX, 0.0f64), |(lo, hi), m| {
@@ -143,13 +143,14 @@ pub(super) fn run(args: &ShapeArgs) -> Result<(), String> {
     let (t_short, t_long) = bank.modes.iter().fold((f64::MAX, 0.0f64), |(s, l), m| {
         (s.min(t60(m.decay_per_s)), l.max(t60(m.decay_per_s)))
     });
-    println!("{}", bank.description);
-    println!(
+    let say = |line: &str| say(&args.output, line);
+    say(&bank.description);
+    say(&format!(
         "  root {root_hz:.2} Hz ({}), {} modes from {lo:.2} Hz to {hi:.2} Hz, T60 {t_short:.3} s \
          to {t_long:.3} s",
         note_name(root_hz),
         bank.modes.len()
-    );
+    ));
     let positions: Vec<String> = bank
         .positions
         .iter()
@@ -158,13 +159,13 @@ pub(super) fn run(args: &ShapeArgs) -> Result<(), String> {
             format!("{} ({})", p.name, coords.join(", "))
         })
         .collect();
-    println!("  positions: {}", positions.join(", "));
-    println!(
+    say(&format!("  positions: {}", positions.join(", ")));
+    say(&format!(
         "{}: {} modes, {} positions",
-        args.output.display(),
+        output_name(&args.output),
         bank.modes.len(),
         bank.positions.len()
-    );
+    ));
     Ok(())
 }
 
