@@ -119,3 +119,37 @@ def test_the_effect_rings_its_input(effect):
     assert np.all(np.isfinite(out))
     tail = float(np.max(np.abs(out[:, RATE // 10 :])))
     assert tail > 1e-3, tail
+
+
+TINY = np.finfo(np.float32).tiny
+
+
+def subnormal_samples(x):
+    x = np.asarray(x, dtype=np.float32)
+    return int(np.count_nonzero((x != 0) & (np.abs(x) < TINY)))
+
+
+@pytest.mark.parametrize("rate", [1_234.5678, 11_025.0, 96_000.0, 1_234_567.8])
+def test_both_plugins_play_at_any_rate_and_no_subnormal_sample_leaves_them(instrument, effect, rate):
+    n = int(rate * 0.5)
+    # A burst, then a tail of subnormal input the dry path would pass through.
+    rng = np.random.default_rng(7)
+    x = np.zeros((2, n), dtype=np.float32)
+    burst = max(n // 20, 8)
+    x[:, :burst] = rng.uniform(-0.25, 0.25, (2, burst))
+    x[:, burst:] = (rng.uniform(-1, 1, (2, n - burst)) * 2 * TINY).astype(np.float32)
+    assert subnormal_samples(x) > 0
+    effect.reset()
+    effect.dry_wet = 50.0
+    out = effect(x, rate, buffer_size=256)
+    assert np.all(np.isfinite(out))
+    assert subnormal_samples(out) == 0, f"{subnormal_samples(out)} subnormal samples at {rate} Hz"
+    assert np.max(np.abs(out)) > 0.01
+
+    instrument.reset()
+    messages = [mido.Message("note_on", note=69, velocity=127, time=0.0)]
+    out = instrument(messages, duration=0.5, sample_rate=rate, buffer_size=256)
+    assert np.all(np.isfinite(out))
+    assert subnormal_samples(out) == 0, f"{subnormal_samples(out)} subnormal samples at {rate} Hz"
+    if rate >= 11_025:
+        assert np.max(np.abs(out)) > 0.06
