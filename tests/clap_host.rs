@@ -951,16 +951,44 @@ fn the_default_bank_peaks_near_minus_6_dbfs_at_its_root() {
 fn the_plugins_list_every_parameter_under_its_stable_id() {
     for (plugin, extra) in [(INSTRUMENT, 0), (EFFECT, 0)] {
         let infos = param_infos(plugin);
-        let mut got: Vec<u32> = infos.iter().map(|(id, _)| id.get()).collect();
+        let mut got: Vec<u32> = infos.iter().map(|p| p.id.get()).collect();
         got.sort();
         let mut want: Vec<u32> = PARAM_IDS.iter().map(|id| param_id(id).get()).collect();
         want.sort();
         assert_eq!(got.len(), want.len() + extra, "{plugin:?} lists {infos:?}");
         assert_eq!(got, want, "{plugin:?}: ids differ from the stable ones");
-        let names: Vec<&str> = infos.iter().map(|(_, n)| n.as_str()).collect();
+        let names: Vec<&str> = infos.iter().map(|p| p.name.as_str()).collect();
         for name in ["Strike position", "Hardness", "Fine tune", "MPE", "Dry/wet"] {
             assert!(names.contains(&name), "{plugin:?} lacks {name}: {names:?}");
         }
+        // The host's bypass button drives the one bypass parameter, outside every group.
+        let bypass: Vec<&ParamDesc> = infos.iter().filter(|p| p.bypass).collect();
+        assert!(
+            bypass.len() == 1 && bypass[0].name == "Bypass" && bypass[0].module.is_empty(),
+            "{plugin:?}: bypass parameters {:?}",
+            bypass.iter().map(|p| (&p.name, &p.module)).collect::<Vec<_>>()
+        );
+        // Every other parameter sits in the group the editor shows it in.
+        let module_of = |name: &str| {
+            let p = infos.iter().find(|p| p.name == name).expect(name);
+            p.module.clone()
+        };
+        for (name, module) in [
+            ("Strike position", "Strike"),
+            ("Hardness", "Strike"),
+            ("Fine tune", "Object"),
+            ("Polyphony", "Voices"),
+            ("Dry/wet", "Output"),
+            ("Pruning", "Pruning"),
+        ] {
+            assert_eq!(module_of(name), module, "{plugin:?}: {name}");
+        }
+        let ungrouped: Vec<&str> = infos
+            .iter()
+            .filter(|p| p.module.is_empty() && !p.bypass)
+            .map(|p| p.name.as_str())
+            .collect();
+        assert!(ungrouped.is_empty(), "{plugin:?}: ungrouped {ungrouped:?}");
     }
 }
 

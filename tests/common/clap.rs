@@ -7,7 +7,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, OnceLock};
 use std::time::{Duration, Instant};
 
-use clack_extensions::params::{ParamInfoBuffer, PluginParams};
+use clack_extensions::params::{ParamInfoBuffer, ParamInfoFlags, PluginParams};
 use clack_extensions::state::PluginState;
 use clack_host::events::event_types::*;
 use clack_host::events::Match;
@@ -395,8 +395,19 @@ fn instantiate(build: Build, plugin: &CStr) -> PluginInstance<Host> {
     .expect("the plugin instantiates")
 }
 
-/// The parameters `plugin` lists through the CLAP params extension: id and name.
-pub fn param_infos(plugin: &CStr) -> Vec<(ClapId, String)> {
+/// A parameter as the CLAP params extension lists it.
+#[derive(Debug)]
+pub struct ParamDesc {
+    pub id: ClapId,
+    pub name: String,
+    /// The module path hosts group it under.
+    pub module: String,
+    /// Whether it is the plugin's bypass (CLAP_PARAM_IS_BYPASS).
+    pub bypass: bool,
+}
+
+/// The parameters `plugin` lists through the CLAP params extension.
+pub fn param_infos(plugin: &CStr) -> Vec<ParamDesc> {
     let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let mut instance = instantiate(Build::Release, plugin);
     let ext = instance
@@ -407,7 +418,12 @@ pub fn param_infos(plugin: &CStr) -> Vec<(ClapId, String)> {
     (0..ext.count(&handle))
         .map(|i| {
             let info = ext.get_info(&handle, i, &mut buffer).expect("param info");
-            (info.id, String::from_utf8_lossy(info.name).into_owned())
+            ParamDesc {
+                id: info.id,
+                name: String::from_utf8_lossy(info.name).into_owned(),
+                module: String::from_utf8_lossy(info.module).into_owned(),
+                bypass: info.flags.contains(ParamInfoFlags::IS_BYPASS),
+            }
         })
         .collect()
 }
