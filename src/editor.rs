@@ -36,6 +36,7 @@ use nice_plug_egui::{create_egui_editor, EguiEditor, EguiEditorState, EguiNiceSe
 
 pub use app::{BankErrorSource, EditorApp, EditorLayout};
 pub use mode_view::DB_SPAN as MODE_VIEW_DB_SPAN;
+pub use params_panel::fixed_strike_axes;
 pub use session::BankSession;
 pub use slider::control_rect;
 

@@ -966,7 +966,10 @@ fn the_plugins_list_every_parameter_under_its_stable_id() {
         assert!(
             bypass.len() == 1 && bypass[0].name == "Bypass" && bypass[0].module.is_empty(),
             "{plugin:?}: bypass parameters {:?}",
-            bypass.iter().map(|p| (&p.name, &p.module)).collect::<Vec<_>>()
+            bypass
+                .iter()
+                .map(|p| (&p.name, &p.module))
+                .collect::<Vec<_>>()
         );
         // Every other parameter sits in the group the editor shows it in.
         let module_of = |name: &str| {

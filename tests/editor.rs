@@ -11,7 +11,7 @@ use std::time::Duration;
 
 use egui::{pos2, vec2, Event, Key, Modifiers, Pos2, Rect};
 use harness::{at, Harness};
-use modal_resonator::editor::control_rect;
+use modal_resonator::editor::{control_rect, fixed_strike_axes};
 use modal_resonator::editor::{
     Audition, EditorShared, EDITOR_MIN_SIZE, EDITOR_SIZE, METER_INTERVAL_S, MODE_VIEW_DB_SPAN,
 };
@@ -104,6 +104,19 @@ fn every_parameter_has_a_labelled_control() {
             let name = unsafe { ptr.name() }.to_string();
             assert!(shown.contains(&name), "parameter {name:?} has no control");
         }
+    }
+}
+
+#[test]
+fn a_strike_axis_the_bank_does_not_vary_along_is_marked() {
+    for (slug, want) in [
+        ("rosewood-marimba-bar", [false, true]),
+        ("glass-plate", [false, false]),
+    ] {
+        let bank = factory_bank(slug).expect(slug);
+        let mut h = Harness::new(Some(&bank));
+        h.settle();
+        assert_eq!(fixed_strike_axes(&h.ctx), Some(want), "{slug}");
     }
 }
 

@@ -255,6 +255,8 @@ impl EditorApp {
         self.shortcuts(ui);
         let params = self.params.clone();
         let shared = self.shared.clone();
+        let positions = self.session.positions();
+        let fixed_axes = [!positions.moves_along(0), !positions.moves_along(1)];
         let width = ui.available_width();
         let side_width = (width * SIDE_PANEL_SHARE).clamp(SIDE_PANEL_WIDTH.0, SIDE_PANEL_WIDTH.1);
         let side_range = SIDE_PANEL_WIDTH.0.min(side_width)..=(width * SIDE_PANEL_MAX_SHARE);
@@ -276,9 +278,9 @@ impl EditorApp {
             .default_size(side_width)
             .size_range(side_range.clone())
             .show(ui, |ui| {
-                ScrollArea::vertical()
-                    .id_salt("parameters")
-                    .show(ui, |ui| params_panel::show(ui, &params, setter, side_width));
+                ScrollArea::vertical().id_salt("parameters").show(ui, |ui| {
+                    params_panel::show(ui, &params, setter, side_width, fixed_axes)
+                });
             });
         let mut loaded = None;
         Panel::right("bank")

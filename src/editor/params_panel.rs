@@ -128,6 +128,15 @@ fn groups(p: &ModalParams) -> Vec<(&'static str, Vec<Control<'_>>)> {
     ]
 }
 
+/// The strike axes the panel last marked as changing nothing for the bank shown (for tests).
+pub fn fixed_strike_axes(ctx: &egui::Context) -> Option<[bool; 2]> {
+    ctx.memory(|m| m.data.get_temp(fixed_axes_id()))
+}
+
+fn fixed_axes_id() -> egui::Id {
+    egui::Id::new("fixed-strike-axes")
+}
+
 /// The names of every parameter the panel shows, in order (for tests).
 pub fn shown_names(params: &ModalParams) -> Vec<String> {
     groups(params)
@@ -147,8 +156,17 @@ fn control_name(c: &Control) -> String {
 
 /// Draws the parameter groups in a panel `panel_width` points wide (the width the panel starts
 /// with: sizing the sliders by the width left would let the panel creep frame by frame).
-pub fn show(ui: &mut Ui, params: &ModalParams, setter: &ParamSetter, panel_width: f32) {
+/// `fixed_axes` says along which axes the bank's strike positions do not vary: the strike
+/// position there changes nothing, and its label says so.
+pub fn show(
+    ui: &mut Ui,
+    params: &ModalParams,
+    setter: &ParamSetter,
+    panel_width: f32,
+    fixed_axes: [bool; 2],
+) {
     let width = (panel_width - LABEL_AND_VALUE_WIDTH).clamp(SLIDER_WIDTH.0, SLIDER_WIDTH.1);
+    ui.memory_mut(|m| m.data.insert_temp(fixed_axes_id(), fixed_axes));
     ui.label(
         egui::RichText::new("Double-click resets · Shift-drag fine · click a value to type")
             .small()
@@ -163,7 +181,19 @@ pub fn show(ui: &mut Ui, params: &ModalParams, setter: &ParamSetter, panel_width
                     .spacing([8.0, 4.0])
                     .show(ui, |ui| {
                         for control in &controls {
-                            ui.label(control_name(control));
+                            let name = control_name(control);
+                            let fixed = [&params.strike.strike_x, &params.strike.strike_y]
+                                .iter()
+                                .zip(fixed_axes)
+                                .any(|(p, fixed)| fixed && p.name() == name);
+                            if fixed {
+                                ui.label(egui::RichText::new(&name).weak()).on_hover_text(
+                                    "The bank's strike positions do not vary along this axis: \
+                                     moving it changes nothing for this bank.",
+                                );
+                            } else {
+                                ui.label(name);
+                            }
                             show_control(ui, control, setter, width);
                             ui.end_row();
                         }

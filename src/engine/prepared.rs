@@ -265,7 +265,8 @@ impl PreparedBank {
             let a = ringing.bank.column_amplitudes();
             let dot = |w: &[f32; COLUMNS]| a.iter().zip(w).map(|(x, w)| x * w).sum::<f32>();
             let bound = dot(&wl).max(dot(&wr));
-            if bound <= peak || bound.is_nan() || (ringing.spent + cost) as f64 > PEAK_MODE_SAMPLES {
+            if bound <= peak || bound.is_nan() || (ringing.spent + cost) as f64 > PEAK_MODE_SAMPLES
+            {
                 return peak;
             }
             for _ in 0..step / RUN {
