@@ -134,7 +134,7 @@ pub fn fixed_strike_axes(ctx: &egui::Context) -> Option<[bool; 2]> {
 }
 
 fn fixed_axes_id() -> egui::Id {
-    egui::Id::new("fixed-strike-axes")
+    egui::Id::unique("fixed-strike-axes")
 }
 
 /// The names of every parameter the panel shows, in order (for tests).
