@@ -322,7 +322,11 @@ pub fn render_to<E>(
     engine.prepare(settings.sample_rate_hz as f32, block);
 
     let mut events = schedule(notes, rate);
-    let dropped = events.iter().any(|e| e.sample >= max_samples);
+    // A release past the end changes nothing that is not still sounding at the cut; a strike
+    // past it is a note not played.
+    let dropped = events
+        .iter()
+        .any(|e| e.sample >= max_samples && matches!(e.event, NoteEvent::On { .. }));
     events.retain(|e| e.sample < max_samples);
     let last_event_end = events.last().map_or(0, |e| e.sample + 1);
     let estimated_len = (last_event_end as f64 + estimated_tail_s(bank, engine.controls()) * rate)

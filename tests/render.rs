@@ -359,6 +359,9 @@ fn max_seconds_caps_the_render() {
     let r = render_text(&quick, "69:1@0, 69:1@5", &s);
     assert!(r.cut_short);
     assert!(r.len() <= 2 * RATE as usize);
+    // A release after the limit, of a note that has died away before it, cuts nothing.
+    let r = render_text(&quick, "69:1@0+5", &s);
+    assert!(!r.cut_short);
 }
 
 #[test]
