@@ -596,6 +596,27 @@ fn a_silent_render_warns_and_exits_with_its_own_status() {
         );
         assert!(dir.path().join("out.wav").is_file(), "{name}: no file");
     }
+    // A MIDI file of a tempo alone: the warning says there is nothing to play.
+    let mut midi = b"MThd\x00\x00\x00\x06\x00\x00\x00\x01\x01\xe0MTrk\x00\x00\x00\x0b".to_vec();
+    midi.extend_from_slice(b"\x00\xff\x51\x03\x07\xa1\x20\x00\xff\x2f\x00");
+    std::fs::write(dir.path().join("tempo.mid"), midi).unwrap();
+    let out = run(
+        dir.path(),
+        &[
+            "render",
+            "rosewood-marimba-bar",
+            "--midi",
+            "tempo.mid",
+            "-o",
+            "out.wav",
+        ],
+    );
+    assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("no notes to play"),
+        "{}",
+        stderr(&out)
+    );
 }
 
 #[test]

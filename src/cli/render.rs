@@ -229,6 +229,13 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
             args.bits.name()
         );
     }
+    if silent && notes.is_empty() {
+        eprintln!(
+            "warning: the render is silent: there are no notes to play (a MIDI file with no \
+             note-on, or only tempo and other meta events)"
+        );
+        return Ok(ExitCode::from(SILENT_EXIT));
+    }
     if silent {
         eprintln!(
             "warning: the render is silent: every sample rounds to zero in the {} file. The \
