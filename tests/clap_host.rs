@@ -403,8 +403,16 @@ fn no_subnormal_sample_leaves_either_plugin_whatever_the_host_does() {
     // port between bursts of noise: every output sample is finite and not subnormal.
     let mut rng = modal_resonator::dsp::rng::Rng::new(0x9e37_79b9);
     let mut next = move || rng.next_u32() as f64 / u32::MAX as f64;
-    let rates = [1_234.567_8, 11_025.0, 44_100.0, 48_000.0, 96_000.0];
-    for case in 0..12 {
+    let rates = [
+        1_234.567_8,
+        11_025.0,
+        44_100.0,
+        48_000.0,
+        96_000.0,
+        384_000.0,
+        1_234_567.8,
+    ];
+    for case in 0..16 {
         let plugin = if case % 2 == 0 { INSTRUMENT } else { EFFECT };
         let rate = rates[(next() * rates.len() as f64) as usize % rates.len()];
         let samples = (rate * 0.4) as usize;
