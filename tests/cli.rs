@@ -1307,6 +1307,21 @@ fn outputs_follow_links_keep_permissions_and_refuse_what_is_no_file() {
     let mode = std::fs::metadata(d.join("private.wav")).unwrap().mode() & 0o777;
     assert_eq!(mode, 0o600);
 
+    // And its owner, where the writer may give it away (as root, as CI runs).
+    // SAFETY: geteuid has no preconditions.
+    if unsafe { libc::geteuid() } == 0 {
+        std::fs::write(d.join("theirs.wav"), b"old").unwrap();
+        std::os::unix::fs::chown(d.join("theirs.wav"), Some(65_534), Some(65_534)).unwrap();
+        let out = render_to("theirs.wav");
+        assert!(out.status.success(), "{}", stderr(&out));
+        let meta = std::fs::metadata(d.join("theirs.wav")).unwrap();
+        assert!(is_wav(&d.join("theirs.wav")));
+        assert_eq!((meta.uid(), meta.gid()), (65_534, 65_534));
+        std::fs::remove_file(d.join("theirs.wav")).unwrap();
+    } else {
+        eprintln!("not root: the owner of a file replaced is not checked");
+    }
+
     // A named pipe, a device and a directory are refused, named, and left as they were.
     let fifo = d.join("pipe.wav");
     let c_path = std::ffi::CString::new(fifo.as_os_str().as_encoded_bytes()).unwrap();

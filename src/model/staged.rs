@@ -3,8 +3,9 @@
 //! any, so a failure leaves every destination as it was.
 //!
 //! The destination is where the path leads ([`destination`]): a symbolic link is followed and
-//! its target replaced (the link stays a link), an existing file keeps its permissions, and
-//! anything but a regular file (a directory, a device, a named pipe, a socket) is refused.
+//! its target replaced (the link stays a link), an existing file keeps its permissions (and, as
+//! root, its owner), and anything but a regular file (a directory, a device, a named pipe, a
+//! socket) is refused.
 
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
@@ -94,6 +95,9 @@ pub struct Destination {
     /// The permissions of the regular file there now, kept by the new one; `None` when there is
     /// no file yet.
     pub permissions: Option<std::fs::Permissions>,
+    /// The owner (user and group ids) of the regular file there now, kept by the new one when
+    /// this process may give it to them (as root); `None` when there is no file yet.
+    pub owner: Option<(u32, u32)>,
 }
 
 /// Most symbolic links followed in a row, as the kernel's `ELOOP` limit.
@@ -111,6 +115,7 @@ pub fn destination(path: &Path) -> io::Result<Destination> {
                 return Ok(Destination {
                     path,
                     permissions: None,
+                    owner: None,
                 })
             }
             Err(e) => return Err(e),
@@ -125,9 +130,17 @@ pub fn destination(path: &Path) -> io::Result<Destination> {
             continue;
         }
         if kind.is_file() {
+            #[cfg(unix)]
+            let owner = {
+                use std::os::unix::fs::MetadataExt;
+                Some((meta.uid(), meta.gid()))
+            };
+            #[cfg(not(unix))]
+            let owner = None;
             return Ok(Destination {
                 path,
                 permissions: Some(meta.permissions()),
+                owner,
             });
         }
         return Err(io::Error::new(
@@ -180,6 +193,15 @@ pub fn temp_beside(
     #[cfg(unix)]
     builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
     let temp = tracked(|| builder.tempfile_in(dir), |t| t.path())?;
+    // The owner first: changing it may clear the set-id bits the permissions then restore.
+    // Only root may give a file away; anyone else's replacement is their own, as an editor's.
+    #[cfg(unix)]
+    if let Some((uid, gid)) = destination.owner {
+        match std::os::unix::fs::fchown(temp.as_file(), Some(uid), Some(gid)) {
+            Err(e) if e.kind() != io::ErrorKind::PermissionDenied => return Err(e),
+            _ => {}
+        }
+    }
     if let Some(permissions) = &destination.permissions {
         temp.as_file().set_permissions(permissions.clone())?;
     }
