@@ -1178,6 +1178,33 @@ fn shape_refuses_bad_names_and_dimensions_cleanly() {
         let out = run(dir.path(), &command);
         assert_failed_cleanly(&out, expected, dir.path(), &[]);
     }
+    // Proportions hold for the object as tuned: a 7 cm thick bar is slender once tuned down to
+    // 200 Hz (1.3 m long), and a marimba bar tuned to 12 kHz is shorter than it is wide.
+    let out = run(
+        dir.path(),
+        &[
+            "shape",
+            "free-free-bar",
+            "--thickness",
+            "0.07",
+            "--tune-hz",
+            "200",
+            "-o",
+            "tuned.json",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    std::fs::remove_file(dir.path().join("tuned.json")).unwrap();
+    let out = run(
+        dir.path(),
+        &["shape", "tuned-bar", "--tune-hz", "12000", "-o", "x.json"],
+    );
+    assert_failed_cleanly(
+        &out,
+        &["width_m", "(0.0572 m): that is a plate"],
+        dir.path(),
+        &[],
+    );
     let help = run(dir.path(), &["shape", "--help"]);
     let text = stdout(&help);
     for word in [

@@ -82,8 +82,8 @@ fn factory_presets_are_up_to_date() {
 }
 
 /// How far from -6 dBFS a full-velocity strike on the root key may peak, in dB: the engine
-/// normalises each bank to -6 dBFS at its first position; the strike position a bank's defaults
-/// choose, and the nearest key for a root between keys, move the peak a little.
+/// normalises each bank to -6 dBFS at its default strike position and root pitch; the nearest
+/// key for a root between keys, and the sample rate, move the peak a little.
 const PEAK_TOLERANCE_DB: f32 = 1.5;
 
 #[test]

@@ -14,7 +14,7 @@ use super::{check_output_dir, load_bank, output_name, same_file, save_bank_outpu
 pub(super) struct CompressArgs {
     /// Bank file (JSON) or factory bank name.
     bank: String,
-    /// Bank file (JSON) to write.
+    /// Bank file (JSON) to write; - writes it to standard output.
     #[arg(short, long, value_name = "FILE")]
     output: PathBuf,
     /// Modes closer than this many frequency difference limens merge (about 5 Hz at 2 kHz and

@@ -21,7 +21,7 @@ pub(super) struct FitArgs {
     /// FILE.wav=POSITION; the position is named after the file when not given.
     #[arg(required = true, value_name = "FILE[=POSITION]")]
     recordings: Vec<String>,
-    /// Bank file (JSON) to write.
+    /// Bank file (JSON) to write; - writes it to standard output.
     #[arg(short, long, value_name = "FILE")]
     output: PathBuf,
     /// Most modes in the bank: the fit keeps the modes that measurably improve the

@@ -22,7 +22,7 @@ pub(super) struct ShapeArgs {
     /// Object to build (listed below).
     #[arg(value_parser = parse_object, value_name = "OBJECT")]
     object: &'static ObjectKind,
-    /// Bank file (JSON) to write.
+    /// Bank file (JSON) to write; - writes it to standard output.
     #[arg(short, long, value_name = "FILE")]
     output: PathBuf,
     /// Material (listed below); each object has its usual one.

@@ -123,8 +123,11 @@ impl Engines {
             self.blocks_waiting = 0;
             return Some(generation);
         }
-        let arrived = self.playing_generation == generation && !outgrown;
-        if arrived || failed_generation == generation {
+        // A bank that failed to load is not asked for again, unless the one playing still
+        // lacks the voices asked for (a rebuild for them lost to that failed bank): the failed
+        // generation then holds the playing bank again.
+        let settled = self.playing_generation == generation || failed_generation == generation;
+        if settled && !outgrown {
             return None;
         }
         self.blocks_waiting += 1;
@@ -268,6 +271,11 @@ mod tests {
         // A lost request is repeated.
         let repeats = (0..RETRY_BLOCKS).filter_map(|_| engines.request(1, 0, MAX_POLYPHONY));
         assert_eq!(repeats.count(), 1);
+        // A new bank supersedes the rebuild, then fails to load: the bank playing still lacks
+        // the voices, and the failed generation (which holds it again) is asked for.
+        assert_eq!(engines.request(2, 0, MAX_POLYPHONY), Some(2));
+        let repeats = (0..RETRY_BLOCKS).filter_map(|_| engines.request(2, 2, MAX_POLYPHONY));
+        assert_eq!(repeats.collect::<Vec<_>>(), [2]);
 
         // A small bank has every voice: no polyphony needs a rebuild.
         let (mut engines, _background) = Engines::new();

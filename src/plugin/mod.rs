@@ -393,7 +393,10 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
                     let max_block = shared.max_block.load(Ordering::Acquire) as usize;
                     let polyphony = params.voices.polyphony.value().max(1) as usize;
                     let engine = build_engine(&bank, polyphony, rate, max_block);
-                    set_error(&shared, None);
+                    // A rebuild of the bank kept after a failed load leaves that failure shown.
+                    if shared.failed_generation.load(Ordering::Acquire) != generation {
+                        set_error(&shared, None);
+                    }
                     if let Ok(mut playing) = shared.playing_json.write() {
                         *playing = json;
                     }

@@ -119,14 +119,18 @@ impl Bar {
     pub(super) fn validate(&self) -> Result<(), ShapeError> {
         super::check_positive("length_m", self.length_m)?;
         super::check_positive("width_m", self.width_m)?;
-        super::check_positive("thickness_m", self.thickness_m)?;
+        super::check_positive("thickness_m", self.thickness_m)
+    }
+
+    /// `Ok` when the bar is slender enough for the theory: checked once it is tuned.
+    pub(super) fn check_proportions(&self) -> Result<(), ShapeError> {
         super::check_thin("thickness_m", self.thickness_m, self.length_m, "length")?;
         if self.width_m > self.length_m {
             return Err(ShapeError::BadParameter {
                 name: "width_m",
                 value: self.width_m,
                 reason: format!(
-                    "wider than the bar is long ({} m): that is a plate",
+                    "wider than the bar is long ({:.4} m): that is a plate",
                     self.length_m
                 ),
             });

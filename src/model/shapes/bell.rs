@@ -98,8 +98,7 @@ impl TunedBell {
 
     pub(super) fn validate(&self) -> Result<(), ShapeError> {
         super::check_positive("diameter_m", self.diameter_m)?;
-        super::check_positive("thickness_m", self.thickness_m)?;
-        super::check_thin("thickness_m", self.thickness_m, self.diameter_m, "diameter")
+        super::check_positive("thickness_m", self.thickness_m)
     }
 
     /// The partials within the limits, heuristic shapes at `coords` (along the profile).

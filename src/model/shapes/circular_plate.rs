@@ -214,13 +214,7 @@ impl CircularPlate {
 
     pub(super) fn validate(&self) -> Result<(), ShapeError> {
         super::check_positive("radius_m", self.radius_m)?;
-        super::check_positive("thickness_m", self.thickness_m)?;
-        super::check_thin(
-            "thickness_m",
-            self.thickness_m,
-            2.0 * self.radius_m,
-            "diameter",
-        )
+        super::check_positive("thickness_m", self.thickness_m)
     }
 
     /// The lowest modes within the limits, shapes (unit mean square over the plate) at `coords`.

@@ -66,12 +66,6 @@ impl CircularMembrane {
     pub(super) fn validate(&self) -> Result<(), ShapeError> {
         super::check_positive("radius_m", self.radius_m)?;
         super::check_positive("thickness_m", self.thickness_m)?;
-        super::check_thin(
-            "thickness_m",
-            self.thickness_m,
-            2.0 * self.radius_m,
-            "diameter",
-        )?;
         super::check_positive("tension_n_per_m", self.tension_n_per_m)
     }
 

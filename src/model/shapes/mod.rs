@@ -142,7 +142,7 @@ impl fmt::Display for ShapeError {
                 f,
                 "the object's lowest mode would be at {} Hz, below the \
                  {min_freq_hz} Hz a bank's modes start at: make it smaller, thicker, stiffer or \
-                 tighter (or tune it with --tune-hz)",
+                 tighter, or tune it higher (--tune-hz, --root-note)",
                 if *lowest_hz >= 0.01 {
                     format!("{lowest_hz:.3}")
                 } else {
@@ -180,7 +180,7 @@ pub(crate) fn check_thin(
             name,
             value: thickness,
             reason: format!(
-                "more than a fifth of the {what} ({span} m): the object is too thick for the \
+                "more than a fifth of the {what} ({span:.4} m): the object is too thick for the \
                  thin-object theory its modes come from"
             ),
         })

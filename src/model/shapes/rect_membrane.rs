@@ -67,8 +67,6 @@ impl RectangularMembrane {
         super::check_positive("length_x_m", self.length_x_m)?;
         super::check_positive("length_y_m", self.length_y_m)?;
         super::check_positive("thickness_m", self.thickness_m)?;
-        let side = self.length_x_m.min(self.length_y_m);
-        super::check_thin("thickness_m", self.thickness_m, side, "shorter side")?;
         super::check_positive("tension_n_per_m", self.tension_n_per_m)
     }
 

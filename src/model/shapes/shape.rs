@@ -82,6 +82,39 @@ impl Shape {
         }
     }
 
+    /// `Ok` when the object is thin or slender enough for the theory its modes come from: a
+    /// thickness (a string's diameter) at most a fifth of its length, diameter or shorter side,
+    /// and a bar no wider than long. Checked on the object as tuned, whose size may differ.
+    pub fn check_proportions(&self) -> Result<(), ShapeError> {
+        use super::check_thin;
+        match self {
+            Self::IdealString(s) | Self::StiffString(s) => {
+                check_thin("diameter_m", s.diameter_m, s.length_m, "length")
+            }
+            Self::FreeFreeBar(bar) | Self::ClampedFreeBar(bar) => bar.check_proportions(),
+            Self::TunedBar(tuned) => tuned.bar.check_proportions(),
+            Self::CircularMembrane(m) => {
+                check_thin("thickness_m", m.thickness_m, 2.0 * m.radius_m, "diameter")
+            }
+            Self::RectangularMembrane(m) => check_thin(
+                "thickness_m",
+                m.thickness_m,
+                m.length_x_m.min(m.length_y_m),
+                "shorter side",
+            ),
+            Self::RectangularPlate(p) => check_thin(
+                "thickness_m",
+                p.thickness_m,
+                p.length_x_m.min(p.length_y_m),
+                "shorter side",
+            ),
+            Self::CircularPlate(p) => {
+                check_thin("thickness_m", p.thickness_m, 2.0 * p.radius_m, "diameter")
+            }
+            Self::Bell(b) => check_thin("thickness_m", b.thickness_m, b.diameter_m, "diameter"),
+        }
+    }
+
     /// The pitch the object is named by, in Hz: its lowest mode, except for a bell, whose
     /// strike note is the prime (an octave above the hum).
     pub fn root_hz(&self, material: &Material) -> f64 {
@@ -139,6 +172,7 @@ impl Shape {
         limits: &ModeLimits,
     ) -> Result<Vec<Mode>, ShapeError> {
         self.validate()?;
+        self.check_proportions()?;
         let shaped = match self {
             Self::IdealString(s) => {
                 s.shaped_modes(material, false, &line_coords(positions)?, limits)

@@ -91,8 +91,7 @@ impl StretchedString {
     pub(super) fn validate(&self) -> Result<(), ShapeError> {
         super::check_positive("length_m", self.length_m)?;
         super::check_positive("diameter_m", self.diameter_m)?;
-        super::check_positive("tension_n", self.tension_n)?;
-        super::check_thin("diameter_m", self.diameter_m, self.length_m, "length")
+        super::check_positive("tension_n", self.tension_n)
     }
 
     /// Modes up to the limits, with shapes `sqrt(2) sin(n pi x)` (unit mean square) at `coords`
