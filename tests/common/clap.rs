@@ -48,8 +48,9 @@ impl HostHandlers for Host {
 pub enum Build {
     /// `cargo xtask bundle modal-resonator --release`, in `target/bundled`.
     Release,
-    /// `CARGO_TARGET_DIR=target/alloc-check cargo xtask bundle modal-resonator --features
-    /// assert_process_allocs`: a debug build that aborts on any allocation in `process`.
+    /// `cargo xtask bundle modal-resonator --features assert_process_allocs`, its
+    /// `target/bundled` then moved to `target/alloc-check/bundled`: a debug build that aborts
+    /// on any allocation in `process`.
     AllocCheck,
 }
 
@@ -66,7 +67,9 @@ pub fn bundle(build: Build) -> PathBuf {
         Build::Release => (target.to_path_buf(), "cargo xtask bundle modal-resonator --release"),
         Build::AllocCheck => (
             target.join("alloc-check"),
-            "CARGO_TARGET_DIR=target/alloc-check cargo xtask bundle modal-resonator --features assert_process_allocs",
+            "cargo xtask bundle modal-resonator --features assert_process_allocs && rm -rf \
+             target/alloc-check && mkdir target/alloc-check && mv target/bundled \
+             target/alloc-check/ && cargo xtask bundle modal-resonator --release",
         ),
     };
     let path = dir.join("bundled").join("Modal Resonator.clap");
