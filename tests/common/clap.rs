@@ -64,7 +64,10 @@ pub fn bundle(build: Build) -> PathBuf {
         .and_then(|p| p.parent())
         .unwrap();
     let (dir, how) = match build {
-        Build::Release => (target.to_path_buf(), "cargo xtask bundle modal-resonator --release"),
+        Build::Release => (
+            target.to_path_buf(),
+            "cargo xtask bundle modal-resonator --release",
+        ),
         Build::AllocCheck => (
             target.join("alloc-check"),
             "cargo xtask bundle modal-resonator --features assert_process_allocs && rm -rf \
