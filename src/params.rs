@@ -506,6 +506,11 @@ impl ModalParams {
         })
     }
 
+    /// Notes at once, 1 to [`MAX_POLYPHONY`].
+    pub fn polyphony(&self) -> usize {
+        self.voices.polyphony.value().clamp(1, MAX_POLYPHONY as i32) as usize
+    }
+
     /// The engine controls for the current values, with the channel's expression: pitch bend
     /// (-1 to 1), mod wheel and pressure (0 to 1).
     pub fn controls(&self, bend: f32, mod_wheel: f32, pressure: f32) -> Controls {
@@ -560,7 +565,7 @@ impl ModalParams {
             release_damping: self.material.release_damping.value(),
             extra_damping: extra_damping.min(1.0),
             truncation_db: self.voices.truncation.value(),
-            polyphony: self.voices.polyphony.value().clamp(1, MAX_POLYPHONY as i32) as usize,
+            polyphony: self.polyphony(),
             width: self.output.width.value(),
             output_gain_db: self.output.output_gain.value(),
             input_gain_db: self.input.input_gain.value(),

@@ -391,8 +391,7 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
                 Ok(bank) => {
                     let rate = f32::from_bits(shared.sample_rate_bits.load(Ordering::Acquire));
                     let max_block = shared.max_block.load(Ordering::Acquire) as usize;
-                    let polyphony = params.voices.polyphony.value().max(1) as usize;
-                    let engine = build_engine(&bank, polyphony, rate, max_block);
+                    let engine = build_engine(&bank, params.polyphony(), rate, max_block);
                     // A rebuild of the bank kept after a failed load leaves that failure shown.
                     if shared.failed_generation.load(Ordering::Acquire) != generation {
                         set_error(&shared, None);
@@ -479,8 +478,7 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
                 }
             }
         };
-        let polyphony = self.params.voices.polyphony.value().max(1) as usize;
-        let mut engine = build_engine(&bank, polyphony, rate, max_block);
+        let mut engine = build_engine(&bank, self.params.polyphony(), rate, max_block);
         engine.set_last_key(self.last_key);
         self.engines.activate(engine, generation);
         true
@@ -512,7 +510,7 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         let started = self.editor_state.is_open().then(Instant::now);
         let generation = self.params.bank.generation.load(Ordering::Acquire);
         let failed = self.shared.failed_generation.load(Ordering::Acquire);
-        let polyphony = self.params.voices.polyphony.value().max(1) as usize;
+        let polyphony = self.params.polyphony();
         if let Some(generation) = self.engines.request(generation, failed, polyphony) {
             let epoch = self.engines.epoch;
             context.execute_background(Task::LoadBank { generation, epoch });
