@@ -11,7 +11,8 @@
 //! Run with `cargo bench --bench fit`. From the environment: `FIT_ONLY=slug,slug` (a subset),
 //! `FIT_CORPUS_DIR=DIR` (also write the recordings as WAV files there; empty for
 //! `target/fit-corpus`), and options for the project's fitter: `FIT_MODES`, `FIT_WINDOW_MS`,
-//! `FIT_MAX_SECONDS`, `FIT_NOISE_FLOOR_DB`. `FIT_SCORE_BANDS=1` prints, for each recording and
+//! `FIT_MAX_SECONDS`, `FIT_NOISE_FLOOR_DB`, `FIT_THREADS` (1 unless given; 0 takes one per
+//! core). `FIT_SCORE_BANDS=1` prints, for each recording and
 //! fitter, the mean signed difference of the re-synthesis from the recording in each band of
 //! the score, over the attack and the tail: where a fit is too loud or too quiet.
 //!
@@ -44,6 +45,9 @@ use fit_score::{fitted_modes, score, Score};
 
 /// Files the quick run scores: short ones, of three packages.
 const QUICK_SLUGS: [&str; 3] = ["claves-freepats", "agogo-high-freepats", "claves-fluid"];
+/// Recordings at least this long, in seconds, count in the speed summary: a shorter one's fit
+/// time is mostly fixed costs.
+const SPEED_MIN_S: f64 = 1.0;
 /// A file scoring above this, in dB over all frames, is counted as a poor fit.
 const POOR_DB: f64 = 5.0;
 
@@ -75,6 +79,8 @@ fn options() -> FitOptions {
         o.max_seconds = v;
     }
     o.noise_floor_db = var("FIT_NOISE_FLOOR_DB").or(o.noise_floor_db);
+    // One core unless asked: the speed target is per core.
+    o.threads = var("FIT_THREADS").map_or(1, |v| v as usize);
     o
 }
 
@@ -105,14 +111,14 @@ fn seed_000(recording: &Recording) -> Outcome {
 /// Prints the table's heading.
 fn print_heading() {
     println!(
-        "{:<26} {:>4} | {:^39} | {:^39}",
-        "recording", "cut", "ours", "seed 000 binning"
+        "{:<26} {:>5} {:>4} | {:^39} | {:^39}",
+        "recording", "s", "cut", "ours", "seed 000 binning"
     );
     let half = format!(
         "{:>6} {:>6} {:>6} {:>5} {:>6} {:>5}",
         "all dB", "attack", "tail", "modes", "cents", "ms"
     );
-    println!("{:<26} {:>4} | {half} | {half}", "", "");
+    println!("{:<26} {:>5} {:>4} | {half} | {half}", "", "", "");
 }
 
 /// `v` to `decimals` places, or "-" where there is nothing to show (a recording with no tail).
@@ -149,8 +155,9 @@ fn row(entry: &Entry, recording: &Recording, options: &FitOptions) -> (Outcome, 
         ""
     };
     println!(
-        "{:<26} {cut:>4} | {} | {}",
+        "{:<26} {:>5.2} {cut:>4} | {} | {}",
         entry.slug,
+        seconds(recording),
         cells(&a),
         cells(&b)
     );
@@ -160,6 +167,11 @@ fn row(entry: &Entry, recording: &Recording, options: &FitOptions) -> (Outcome, 
         }
     }
     (a, b)
+}
+
+/// Length of `recording` in seconds.
+fn seconds(recording: &Recording) -> f64 {
+    recording.samples.len() as f64 / f64::from(recording.sample_rate_hz)
 }
 
 /// Mean of the finite values of `pick` over the fitted outcomes.
@@ -206,6 +218,31 @@ fn summary(who: &str, outcomes: &[&Outcome]) {
     );
 }
 
+/// Prints how the project's fitter's wall time compares with the length of the sound, over the
+/// recordings of at least [`SPEED_MIN_S`] (the target: no longer than the sound lasts).
+fn speed(entries: &[&Entry], recordings: &[Recording], pairs: &[(Outcome, Outcome)]) {
+    let ratios: Vec<(&str, f64)> = entries
+        .iter()
+        .zip(recordings)
+        .zip(pairs)
+        .filter_map(|((e, r), p)| match p.0 {
+            Outcome::Fitted(_, _, wall_s) if seconds(r) >= SPEED_MIN_S => {
+                Some((e.slug, wall_s / seconds(r)))
+            }
+            _ => None,
+        })
+        .collect();
+    let Some(&(slowest, worst)) = ratios.iter().max_by(|a, b| a.1.total_cmp(&b.1)) else {
+        return;
+    };
+    println!(
+        "ours      on the {} files of at least {SPEED_MIN_S} s: {} fitted slower than they \
+         last; slowest {worst:.2} s of fitting per second of sound ({slowest})",
+        ratios.len(),
+        ratios.iter().filter(|r| r.1 > 1.0).count(),
+    );
+}
+
 /// Whether the project's fitter did better on a file: a lower score over all frames, or a fit
 /// where the reference refused.
 fn ours_better(pair: &(Outcome, Outcome)) -> bool {
@@ -228,6 +265,7 @@ fn compare(entries: &[&Entry], recordings: &[Recording]) {
     println!();
     summary("ours", &pairs.iter().map(|p| &p.0).collect::<Vec<_>>());
     summary("seed 000", &pairs.iter().map(|p| &p.1).collect::<Vec<_>>());
+    speed(entries, recordings, &pairs);
     println!(
         "ours better (lower all-frames score) on {} of {} files",
         pairs.iter().filter(|p| ours_better(p)).count(),

@@ -37,10 +37,11 @@ pub use pruning::PruningStats;
 use stereo::lane_weights;
 use voice::{PendingStrike, Tuning, Voice, VoiceOverrides, VoiceState};
 
-use crate::dsp::coeffs::{db_to_gain, t60_to_decay, MIN_DECAY_PER_S};
+use crate::dsp::coeffs::MIN_DECAY_PER_S;
 use crate::dsp::denormal::FlushDenormals;
 use crate::dsp::rng::Rng;
 use crate::dsp::{Kernel, COLUMNS};
+use crate::units::{db_to_gain, t60_to_decay};
 
 /// Samples between control updates: smoothing steps, coefficient updates and mode truncation.
 pub const CONTROL_PERIOD: usize = 64;

@@ -11,5 +11,6 @@ pub mod model;
 pub mod params;
 pub mod plugin;
 pub mod render;
+pub mod units;
 
 pub use plugin::{ModalResonator, ModalResonatorFx};

@@ -16,9 +16,10 @@ pub use midi_file::read_midi_file;
 pub use notes::{parse_notes, Note};
 pub use wav::{to_int_sample, wav_bytes, write_wav, BitDepth, WavFile};
 
-use crate::dsp::coeffs::{db_to_gain, gain_to_db};
-use crate::engine::{Controls, Engine, NoteEvent, PreparedBank};
+use crate::dsp::ExciterKind;
+use crate::engine::{Controls, Engine, NoteEvent, PositionMap, PreparedBank};
 use crate::model::Bank;
+use crate::units::{db_to_gain, gain_to_db};
 
 /// Silence kept after the last sound (or the last event, if later), in seconds: enough that a
 /// player does not cut the very end of the tail.
@@ -264,6 +265,49 @@ impl RenderSummary {
             peak => gain_to_db(peak),
         }
     }
+}
+
+/// Quietest level [`resynthesize`] renders, in dBFS: far below any recording's noise.
+const RESYNTHESIS_TRUNCATION_DB: f32 = -140.0;
+
+/// Key [`resynthesize`] strikes; with key tracking off any key plays the bank as authored.
+const RESYNTHESIS_KEY: u8 = 60;
+
+/// `bank` struck at position `position` with a unit impulse and rendered mono through the
+/// engine for `len` samples at `sample_rate_hz`, in the bank's own units: the engine's loudness
+/// normalisation is undone, so a mode of gain `a` starts at amplitude `a`. What the fit's score
+/// (`model::fit::synthesize_strike`) stands for.
+pub fn resynthesize(bank: &Bank, position: usize, sample_rate_hz: u32, len: usize) -> Vec<f32> {
+    let prepared = Arc::new(PreparedBank::new(bank));
+    let mut controls = Controls::for_bank(bank);
+    controls.exciter = ExciterKind::Impulse;
+    controls.width = 0.0;
+    controls.key_tracking = 0.0;
+    controls.position_variation = 0.0;
+    controls.truncation_db = RESYNTHESIS_TRUNCATION_DB;
+    let coords: Vec<Vec<f64>> = bank.positions.iter().map(|p| p.coords.clone()).collect();
+    if let Some(at) = PositionMap::new(&coords).coords().get(position) {
+        controls.strike_x = at[0] as f32;
+        controls.strike_y = at[1] as f32;
+    }
+    let settings = RenderSettings {
+        sample_rate_hz,
+        controls,
+        max_seconds: len as f64 / sample_rate_hz as f64,
+        ..RenderSettings::default()
+    };
+    let note = Note {
+        key: RESYNTHESIS_KEY,
+        velocity: 1.0,
+        time_s: 0.0,
+        duration_s: None,
+    };
+    let rendered = render(&prepared, &[note], &settings, |_| {});
+    // With width 0 both channels carry the sum of the modes.
+    let scale = 1.0 / prepared.normalization;
+    let mut out: Vec<f32> = rendered.left.iter().map(|v| v * scale).collect();
+    out.resize(len, 0.0);
+    out
 }
 
 /// Renders `notes` (in any order) through `bank` with `settings` into memory, as

@@ -10,8 +10,8 @@ use clack_host::events::event_types::NoteExpressionType;
 use clack_host::prelude::*;
 use common::clap::*;
 use common::{magnitude_at, peak, pitch_hz, spectral_peak_hz};
-use modal_resonator::dsp::coeffs::gain_to_db;
 use modal_resonator::model::{Bank, Mode, Position};
+use modal_resonator::units::gain_to_db;
 
 #[test]
 fn the_bundle_offers_the_instrument_and_the_effect() {
@@ -948,8 +948,7 @@ fn the_default_bank_peaks_near_minus_6_dbfs_at_its_root() {
         modal_resonator::plugin::DEFAULT_FACTORY_BANK,
     )
     .unwrap();
-    let root =
-        modal_resonator::dsp::coeffs::hz_to_midi_key(bank.effective_root_hz()).round() as u16;
+    let root = modal_resonator::units::hz_to_midi_key(bank.effective_root_hz()).round() as u16;
     let s = session(INSTRUMENT, None, &[(0, Send::On(root, 1.0))], None, 24_000);
     let level = gain_to_db(peak(&s.left).max(peak(&s.right)));
     assert!((level + 6.0).abs() < 1.5, "peak {level} dBFS");

@@ -3,12 +3,12 @@
 mod common;
 
 use common::*;
-use modal_resonator::dsp::coeffs::{db_to_gain, gain_to_db, midi_key_to_hz, t60_to_decay};
 use modal_resonator::engine::{
     Controls, Engine, Note, NoteEvent, NoteExpression, PreparedBank, VoiceModulation,
     CONTROL_PERIOD, MAX_POLYPHONY, TARGET_PEAK,
 };
 use modal_resonator::model::{Bank, BankDefaults, Mode};
+use modal_resonator::units::{db_to_gain, gain_to_db, midi_key_to_hz, t60_to_decay};
 use std::sync::Arc;
 
 const RATE: f32 = 48_000.0;
@@ -69,7 +69,7 @@ fn a_strike_peaks_near_minus_6_dbfs_at_every_rate() {
         dense_bank(12, 1000.0),
     ] {
         let root_key =
-            modal_resonator::dsp::coeffs::hz_to_midi_key(bank.effective_root_hz()).round() as u8;
+            modal_resonator::units::hz_to_midi_key(bank.effective_root_hz()).round() as u8;
         let mut peaks = Vec::new();
         for rate in [44_100.0, 48_000.0, 96_000.0, 192_000.0] {
             let mut e = engine(&bank, rate);

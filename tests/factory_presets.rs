@@ -88,8 +88,8 @@ const PEAK_TOLERANCE_DB: f32 = 1.5;
 
 #[test]
 fn every_factory_bank_validates_and_plays_near_minus_6_dbfs_at_its_root() {
-    use modal_resonator::dsp::coeffs::{gain_to_db, hz_to_midi_key};
     use modal_resonator::model::validate::validate_bank;
+    use modal_resonator::units::{gain_to_db, hz_to_midi_key};
 
     let rate = 48_000.0;
     let banks = factory_banks();
@@ -128,7 +128,7 @@ const BALANCE_TOLERANCE_DB: f64 = 1.0;
 
 #[test]
 fn every_factory_bank_sounds_centred_at_the_default_width() {
-    use modal_resonator::dsp::coeffs::hz_to_midi_key;
+    use modal_resonator::units::hz_to_midi_key;
 
     let rate = 48_000.0;
     let energy = |x: &[f32]| x.iter().map(|&v| v as f64 * v as f64).sum::<f64>();

@@ -8,11 +8,11 @@ use std::sync::Arc;
 use modal_resonator::dsp::ExciterKind;
 use modal_resonator::engine::{Controls, PreparedBank};
 use modal_resonator::model::fit::{
-    compare, fit_bank, resynthesize, FitError, FitOptions, Recording,
+    compare, fit_bank, synthesize_strike, FitError, FitOptions, Recording,
 };
 
 use modal_resonator::model::{Bank, Mode, Position};
-use modal_resonator::render::{render, Note};
+use modal_resonator::render::{render, resynthesize, Note, CUT_FADE_S};
 
 const RATE: u32 = 48_000;
 
@@ -177,7 +177,7 @@ fn db(x: f64) -> f64 {
 }
 
 #[test]
-fn the_renderer_used_here_matches_the_library_resynthesis() {
+fn the_renderer_used_here_matches_the_resyntheses_of_the_renderer_and_the_fit() {
     let bank = truth_bank();
     for k in 0..2 {
         let ours = clean_render(&bank, k);
@@ -187,6 +187,20 @@ fn the_renderer_used_here_matches_the_library_resynthesis() {
             .zip(&theirs)
             .fold(0.0f64, |a, (x, y)| a.max((x - *y as f64).abs()));
         assert!(err < 1e-6, "position {k}: largest difference {err}");
+        // The fit's score synthesises the modes itself, as the engine plays them.
+        // Up to the fade a render cut at its length ends with.
+        let model = synthesize_strike(&bank, k, RATE, ours.len());
+        let faded = (CUT_FADE_S * RATE as f64).ceil() as usize;
+        let peak = model.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let err = model
+            .iter()
+            .zip(&theirs)
+            .take(model.len() - faded)
+            .fold(0.0f64, |a, (x, y)| a.max((x - *y as f64).abs()));
+        assert!(
+            err < 1e-4 * peak,
+            "position {k}: the fit's synthesis is {err} off the engine's (peak {peak})"
+        );
         // The impulse response starts as the model says: y(1/fs) = sum a sin(2 pi f / fs).
         let expected: f64 = bank
             .modes
@@ -341,6 +355,24 @@ fn a_known_bank_is_recovered_from_noisy_renders() {
             r.name,
             r.level_db
         );
+    }
+}
+
+#[test]
+fn the_bank_is_the_same_on_any_number_of_threads() {
+    let truth = truth_bank();
+    let recordings = [noisy_recording(&truth, 0, SNR_DB, 5)];
+    let on = |threads: usize| {
+        let options = FitOptions {
+            threads,
+            ..FitOptions::default()
+        };
+        fit_bank(&recordings, &options).unwrap().bank
+    };
+    let one = on(1);
+    assert!(one.modes.len() >= TRUTH.len(), "{} modes", one.modes.len());
+    for threads in [2, 5] {
+        assert_eq!(on(threads), one, "{threads} threads");
     }
 }
 

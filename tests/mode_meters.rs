@@ -4,9 +4,9 @@
 mod common;
 
 use common::*;
-use modal_resonator::dsp::coeffs::t60_to_decay;
 use modal_resonator::dsp::ExciterKind;
 use modal_resonator::engine::{Engine, PreparedBank};
+use modal_resonator::units::t60_to_decay;
 
 const RATE: f32 = 48_000.0;
 

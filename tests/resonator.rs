@@ -1,7 +1,8 @@
 //! The resonator bank against closed forms, and every kernel against the scalar oracle.
 
-use modal_resonator::dsp::coeffs::{decay_to_t60_s, t60_to_decay, ModeCoeffs};
+use modal_resonator::dsp::coeffs::ModeCoeffs;
 use modal_resonator::dsp::{Kernel, ResonatorBank, COLUMNS};
+use modal_resonator::units::{decay_to_t60_s, t60_to_decay};
 
 fn kernels() -> Vec<Kernel> {
     Kernel::ALL

@@ -44,6 +44,9 @@ pub(super) struct FitArgs {
     /// Longest stretch of each recording analysed after the strike, in seconds.
     #[arg(long, default_value_t = 10.0)]
     max_seconds: f64,
+    /// Threads fitting at once (0: one per core). The bank is the same on any number.
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    threads: usize,
     /// Bank name (default: the output file's name).
     #[arg(long)]
     name: Option<String>,
@@ -101,6 +104,7 @@ pub(super) fn run(args: &FitArgs) -> Result<(), String> {
         noise_floor_db: args.noise_floor_db,
         window_s: args.window_ms * 1e-3,
         max_seconds: args.max_seconds,
+        threads: args.threads,
     };
     let mut progress = Progress::new("fitting");
     let fit = fit_bank_with_progress(&recordings, &options, |done| progress.set(done));

@@ -4,7 +4,6 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use modal_resonator::dsp::coeffs::{decay_to_t60_s, midi_key_to_hz};
 use modal_resonator::model::materials::{Material, MATERIALS};
 use modal_resonator::model::shapes::{
     design_bank, BankDesign, Dimension, ModeLimits, ObjectKind, ObjectSpec, PlateEdge, BAR_TUNINGS,
@@ -12,6 +11,7 @@ use modal_resonator::model::shapes::{
 };
 use modal_resonator::model::summary::{note_name, note_to_midi_key};
 use modal_resonator::model::Position;
+use modal_resonator::units::{decay_to_t60_s, midi_key_to_hz};
 
 use super::{check_output_dir, output_name, save_bank_output, say};
 

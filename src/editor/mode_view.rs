@@ -13,9 +13,9 @@ use super::session::BankSession;
 mod plot;
 
 use super::style;
-use crate::dsp::coeffs::decay_to_t60_s;
 use crate::engine::PositionWeights;
 use crate::model::summary::note_name;
+use crate::units::decay_to_t60_s;
 pub use plot::DB_SPAN;
 use plot::{axes_for, cross, db_to_gain, draw_axes, draw_legend, gain_db, Axes, Mapping, MARGINS};
 

@@ -6,9 +6,10 @@ use std::f64::consts::TAU;
 use super::controls::Controls;
 use super::position::{PositionMap, PositionWeights};
 use super::stereo::{balanced_pans, lane_weights, COLUMN_PAN};
-use crate::dsp::coeffs::{hz_to_midi_key, ModeCoeffs, MIN_DECAY_PER_S};
+use crate::dsp::coeffs::{ModeCoeffs, MIN_DECAY_PER_S};
 use crate::dsp::{Exciter, Kernel, ResonatorBank, COLUMNS};
 use crate::model::Bank;
+use crate::units::hz_to_midi_key;
 
 /// Peak of a full-velocity strike with the bank's default controls (its default strike
 /// position included): -6 dBFS.

@@ -6,8 +6,8 @@
 //! description ([`refine`], [`bandfit`]); leave out hum ([`analyse`]); then match each mode's
 //! level over time to the recording's, in dB, and give the partials still missing a mode
 //! ([`levels`]). Then match modes across recordings and measure every mode's gain in every
-//! recording ([`combine`]), and score each recording against the bank re-synthesised through the
-//! engine at its position ([`fidelity`]). The noise spectrum ([`noise`]) and the per-mode tracks
+//! recording ([`combine`]), and score each recording against the bank re-synthesised at its
+//! position ([`fidelity`]). The noise spectrum ([`noise`]) and the per-mode tracks
 //! ([`track`]) feed the report.
 //!
 //! Gains are in the bank format's units: the amplitude, in full scale of the recording, of the
@@ -40,7 +40,7 @@ use std::collections::HashSet;
 use serde_json::{json, Map};
 
 pub use error::FitError;
-pub use fidelity::{resynthesize, Fidelity};
+pub use fidelity::{synthesize_strike, Fidelity};
 pub use report::{save_report_file, stage_report_file, FitReport, ModeReport, RecordingReport};
 pub use wav::read_wav_recording;
 
@@ -48,8 +48,9 @@ use self::analyse::{analyse, prepare, Analysis};
 use self::combine::{combine, Combined};
 use self::fidelity::fidelity;
 use self::lsq::Shape;
-use crate::dsp::coeffs::{decay_to_t60_s, MAX_FREQ_RATIO};
+use crate::dsp::coeffs::MAX_FREQ_RATIO;
 use crate::model::bank::{Bank, Mode, Position};
+use crate::units::decay_to_t60_s;
 
 /// Most modes in a fitted bank by default: a bound, not a target (the fit keeps the modes that
 /// measurably improve the resynthesis), high enough for a bell or a plate, low enough that a
@@ -114,6 +115,9 @@ pub struct FitOptions {
     pub window_s: f64,
     /// Longest stretch of each recording analysed after the strike, in seconds.
     pub max_seconds: f64,
+    /// Threads that fit a recording's bands at once; 0 takes one per core. The bank does not
+    /// depend on it.
+    pub threads: usize,
 }
 
 impl Default for FitOptions {
@@ -126,6 +130,7 @@ impl Default for FitOptions {
             noise_floor_db: None,
             window_s: 0.17,
             max_seconds: 10.0,
+            threads: 0,
         }
     }
 }

@@ -259,7 +259,7 @@ impl Material {
     }
 }
 
-pub use crate::dsp::coeffs::decay_to_t60_s;
+pub use crate::units::decay_to_t60_s;
 
 #[cfg(test)]
 mod tests {

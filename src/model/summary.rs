@@ -3,7 +3,7 @@
 use std::fmt;
 
 use super::Bank;
-use crate::dsp::coeffs::{decay_to_t60_s, hz_to_midi_key};
+use crate::units::{decay_to_t60_s, hz_to_midi_key};
 
 /// Name of the equal-tempered note nearest `freq_hz` and its offset in cents, e.g. "C4" or
 /// "C4 +12 c".
@@ -220,7 +220,7 @@ mod tests {
         }
         // note_name reads back.
         for key in 0..=127u8 {
-            let hz = crate::dsp::coeffs::midi_key_to_hz(f64::from(key));
+            let hz = crate::units::midi_key_to_hz(f64::from(key));
             assert_eq!(note_to_midi_key(&note_name(hz)), Some(key));
         }
     }

@@ -8,10 +8,10 @@ use super::candidates::{
 };
 use super::{fade_samples, frame_samples, samples_to_cross};
 use super::{DORMANT_FULL_S, FULL_EVERY, GENERATION_MASK, NO_TAG};
-use crate::dsp::coeffs::gain_to_db;
 use crate::dsp::pruning::{keep_most_energetic, Verdict, PRIOR};
 use crate::engine::voice::VoiceState;
 use crate::engine::Engine;
+use crate::units::gain_to_db;
 
 impl Engine {
     /// dB SPL of a unit amplitude at the output now: the playback level, through the output gain.

@@ -25,7 +25,6 @@ use std::time::Instant;
 
 use super::candidates::{energy_db, Reading, DORMANT, DRIVEN};
 use super::{samples_to_cross, OffReason, NO_TAG};
-use crate::dsp::coeffs::db_to_gain;
 use crate::dsp::masking::{power_to_db, DB_PER_NEPER};
 use crate::dsp::prefetch::{self, prefetch};
 use crate::dsp::resonator_bank::{Pulse, PulseShape};
@@ -33,6 +32,7 @@ use crate::dsp::ExciterKind;
 use crate::engine::voice::start_threshold;
 use crate::engine::voice::VoiceState;
 use crate::engine::Engine;
+use crate::units::db_to_gain;
 
 impl Engine {
     /// Before voice `i` is struck by `kind`: modes fading in or out are woken (through their

@@ -15,10 +15,10 @@ mod table;
 pub use compare::first_difference;
 pub use table::factory_table_markdown;
 
-use crate::dsp::coeffs::midi_key_to_hz;
 use crate::model::materials::Material;
 use crate::model::shapes::{design_bank, BankDesign, ModeLimits, Shape};
 use crate::model::Bank;
+use crate::units::midi_key_to_hz;
 use fitted::{FittedPreset, FITTED_PRESETS};
 use std::path::{Path, PathBuf};
 

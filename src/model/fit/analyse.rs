@@ -4,6 +4,8 @@
 //! ([`bandfit`](super::bandfit)).
 
 use realfft::num_complex::Complex64;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::mpsc;
 
 use super::bandfit::{dedupe, fit_band, BandMode};
 use super::levels::match_levels;
@@ -154,7 +156,7 @@ pub fn analyse(
 ) -> Result<Analysis, FitError> {
     let mut analysis = prepare(recording, options)?;
     let max_hz = options.max_hz(recording.sample_rate_hz);
-    find_modes(&mut analysis, options.min_hz, max_hz, progress);
+    find_modes(&mut analysis, options, max_hz, progress);
     drop_steady_tones(&mut analysis);
     match_levels(&mut analysis, options.min_hz, max_hz);
     // Matching levels can leave a mode far under the others.
@@ -231,15 +233,42 @@ pub fn prepare(recording: &Recording, options: &FitOptions) -> Result<Analysis, 
 }
 
 /// The modes of every band, measured jointly in each and kept by what they add to the
-/// resynthesis; a mode two bands find is kept once.
-fn find_modes(a: &mut Analysis, min_hz: f64, max_hz: f64, progress: &mut dyn FnMut(f64)) {
+/// resynthesis; a mode two bands find is kept once. The bands are fitted on
+/// [`FitOptions::threads`] threads, each taking the next band not yet taken, and their modes
+/// gathered in band order, so the result is the same on any number of threads.
+fn find_modes(a: &mut Analysis, options: &FitOptions, max_hz: f64, progress: &mut dyn FnMut(f64)) {
+    let min_hz = options.min_hz;
     let cores = layout(min_hz, max_hz);
-    let mut splitter = Splitter::new(&a.signal, a.sample_rate_hz);
-    let mut found: Vec<BandMode> = Vec::new();
-    for (k, &core) in cores.iter().enumerate() {
-        found.extend(fit_band(&mut splitter, core, k));
-        progress((k + 1) as f64 / cores.len() as f64);
+    let threads = match options.threads {
+        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        n => n,
     }
+    .clamp(1, cores.len().max(1));
+    let next = AtomicUsize::new(0);
+    let (sender, receiver) = mpsc::channel();
+    let mut by_band: Vec<Vec<BandMode>> = vec![Vec::new(); cores.len()];
+    let (signal, rate) = (&a.signal, a.sample_rate_hz);
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            let (sender, next, cores) = (sender.clone(), &next, &cores);
+            scope.spawn(move || {
+                let mut splitter = Splitter::new(signal, rate);
+                loop {
+                    let k = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(&core) = cores.get(k) else { break };
+                    if sender.send((k, fit_band(&mut splitter, core, k))).is_err() {
+                        break;
+                    }
+                }
+            });
+        }
+        drop(sender);
+        for (done, (k, modes)) in receiver.iter().enumerate() {
+            by_band[k] = modes;
+            progress((done + 1) as f64 / cores.len() as f64);
+        }
+    });
+    let mut found: Vec<BandMode> = by_band.into_iter().flatten().collect();
     dedupe(&mut found, a.signal.len() as f64 / a.sample_rate_hz);
     // A band's reach beyond its core stops at the range searched.
     found.retain(|m| (min_hz..=max_hz).contains(&m.freq_hz));

@@ -1,5 +1,5 @@
-//! How close a bank sounds to a recording: the bank re-synthesised through the engine at the
-//! recording's position and compared with it spectrogram to spectrogram.
+//! How close a bank sounds to a recording: the bank's modes re-synthesised at the recording's
+//! position, as the engine plays them, and compared with it spectrogram to spectrogram.
 //!
 //! The score is the log-spectral distance over time: the RMS difference in dB between the two
 //! spectrograms, over the time-frequency cells where either stands above the recording's noise
@@ -9,14 +9,14 @@
 //! the level is not: a bank that reproduces the recording's spectrum and decays but not its
 //! level scores the level difference.
 
-use std::sync::Arc;
+use std::f64::consts::TAU;
+
+use realfft::num_complex::Complex64;
 
 use super::analyse::Analysis;
 use super::stft::{hann, Spectrogram};
-use crate::dsp::ExciterKind;
-use crate::engine::{Controls, PositionMap, PreparedBank};
+use crate::dsp::coeffs::MAX_FREQ_RATIO;
 use crate::model::Bank;
-use crate::render::{render, Note, RenderSettings};
 
 /// Length of the comparison's frames in seconds (rounded to a power of two of samples): about
 /// the ear's time resolution for tones.
@@ -28,12 +28,6 @@ const FLOOR_ABOVE_NOISE_DB: f64 = 6.0;
 /// Cells more than this many dB below the recording's loudest count as silent too.
 pub const DYNAMIC_RANGE_DB: f64 = 60.0;
 
-/// Quietest level the engine renders, in dBFS: far below any recording's noise.
-const TRUNCATION_DB: f32 = -140.0;
-
-/// Key struck for re-synthesis; with key tracking off any key plays the bank as authored.
-const KEY: u8 = 60;
-
 /// The comparison of a recording with the bank's re-synthesis.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Fidelity {
@@ -44,39 +38,33 @@ pub struct Fidelity {
     pub level_db: f64,
 }
 
-/// `bank` struck at position `position` with a unit impulse and rendered mono through the
-/// engine for `len` samples at `sample_rate_hz`, in the bank's own units: the engine's loudness
-/// normalisation is undone, so a mode of gain `a` starts at amplitude `a`.
-pub fn resynthesize(bank: &Bank, position: usize, sample_rate_hz: u32, len: usize) -> Vec<f32> {
-    let prepared = Arc::new(PreparedBank::new(bank));
-    let mut controls = Controls::for_bank(bank);
-    controls.exciter = ExciterKind::Impulse;
-    controls.width = 0.0;
-    controls.key_tracking = 0.0;
-    controls.position_variation = 0.0;
-    controls.truncation_db = TRUNCATION_DB;
-    let coords: Vec<Vec<f64>> = bank.positions.iter().map(|p| p.coords.clone()).collect();
-    if let Some(at) = PositionMap::new(&coords).coords().get(position) {
-        controls.strike_x = at[0] as f32;
-        controls.strike_y = at[1] as f32;
+/// `bank` struck at position `position` with a unit impulse, `len` samples at
+/// `sample_rate_hz`, in the bank's own units: `sum_m a_m exp(-d_m t) sin(2 pi f_m t)`, as the
+/// engine plays it (`render::resynthesize` renders it through the engine, and the tests hold
+/// the two together). Modes the engine leaves out at this rate (at or above
+/// [`MAX_FREQ_RATIO`] of it) are left out.
+pub fn synthesize_strike(
+    bank: &Bank,
+    position: usize,
+    sample_rate_hz: u32,
+    len: usize,
+) -> Vec<f64> {
+    let rate = f64::from(sample_rate_hz);
+    let mut out = vec![0.0; len];
+    for mode in &bank.modes {
+        let gain = mode.gains.get(position).copied().unwrap_or(0.0);
+        if mode.freq_hz >= MAX_FREQ_RATIO * rate || gain == 0.0 {
+            continue;
+        }
+        // The mode's phasor, turned by its pole each sample: its imaginary part is the mode.
+        let pole =
+            Complex64::from_polar((-mode.decay_per_s / rate).exp(), TAU * mode.freq_hz / rate);
+        let mut z = Complex64::new(gain, 0.0);
+        for v in &mut out {
+            *v += z.im;
+            z *= pole;
+        }
     }
-    let settings = RenderSettings {
-        sample_rate_hz,
-        controls,
-        max_seconds: len as f64 / sample_rate_hz as f64,
-        ..RenderSettings::default()
-    };
-    let note = Note {
-        key: KEY,
-        velocity: 1.0,
-        time_s: 0.0,
-        duration_s: None,
-    };
-    let rendered = render(&prepared, &[note], &settings, |_| {});
-    // With width 0 both channels carry the sum of the modes.
-    let scale = 1.0 / prepared.normalization;
-    let mut out: Vec<f32> = rendered.left.iter().map(|v| v * scale).collect();
-    out.resize(len, 0.0);
     out
 }
 
@@ -84,10 +72,7 @@ pub fn resynthesize(bank: &Bank, position: usize, sample_rate_hz: u32, len: usiz
 /// the recording and the bins between `min_hz` and `max_hz`.
 pub fn fidelity(bank: &Bank, position: usize, a: &Analysis, min_hz: f64, max_hz: f64) -> Fidelity {
     let rate = a.sample_rate_hz;
-    let synth: Vec<f64> = resynthesize(bank, position, rate as u32, a.signal.len())
-        .into_iter()
-        .map(f64::from)
-        .collect();
+    let synth = synthesize_strike(bank, position, rate as u32, a.signal.len());
     let len = ((FRAME_S * rate).log2().round().exp2() as usize).min(a.signal.len());
     let sum_sq: f64 = hann(len).iter().map(|w| w * w).sum();
     let rec = Spectrogram::new(&a.signal, rate, len, len / 2, 1);

@@ -706,6 +706,51 @@ mod tests {
         }
     }
 
+    /// The Jacobian's columns are the model's derivatives, by central differences.
+    #[test]
+    fn the_jacobian_is_the_derivative_of_the_model() {
+        let rate = 44_100.0;
+        let x = strike(rate, 20_000, 0.0, || 0.0);
+        let mut splitter = Splitter::new(&x, rate);
+        let band = splitter.band((1008.0, 1129.0), usize::MAX);
+        let target = Target::new(&band, 0..band.samples.len() / 2, 1e-12, 8);
+        let fit = Modes {
+            modes: TRUTH
+                .iter()
+                .map(|&(f, d, g)| mode(&band, f + 0.3, d * 1.2, g))
+                .collect(),
+            tau: 0.3,
+        };
+        let (columns, d_tau) = target.columns(&fit);
+        let nudged = |k: usize, which: usize, h: f64| {
+            let mut f = fit.clone();
+            match which {
+                0 => f.modes[k].s.re += h,
+                1 => f.modes[k].s.im += h,
+                _ => f.tau += h,
+            }
+            target.model(&f)
+        };
+        let check = |got: Vec<Complex64>, k: usize, which: usize, h: f64, name: &str| {
+            let (up, down) = (nudged(k, which, h), nudged(k, which, -h));
+            let peak = got.iter().map(|v| v.norm()).fold(0.0, f64::max);
+            assert!(peak > 0.0, "{name}");
+            for (n, g) in got.iter().enumerate() {
+                let want = (up[n] - down[n]) / (2.0 * h);
+                assert!(
+                    (g - want).norm() < 1e-5 * peak,
+                    "{name} sample {n}: {g} vs {want}"
+                );
+            }
+        };
+        for (k, (c, m)) in columns.iter().zip(&fit.modes).enumerate() {
+            let scaled = |v: &Vec<Complex64>| v.iter().map(|x| x * m.gain).collect();
+            check(scaled(&c.d_log_magnitude), k, 0, 1e-7, "log-magnitude");
+            check(scaled(&c.d_angle), k, 1, 1e-7, "angle");
+        }
+        check(d_tau, 0, 2, 1e-4, "strike time");
+    }
+
     /// Strikes of known modes, one above its band's centre, with the strike a little after the
     /// onset, are recovered from the band's first sample.
     #[test]

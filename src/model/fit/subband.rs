@@ -122,10 +122,6 @@ pub struct Splitter<'a> {
     x: &'a [f64],
     /// Its sample rate in Hz.
     sample_rate_hz: f64,
-    /// Planner of the forward transforms of the sound.
-    real: RealFftPlanner<f64>,
-    /// Planner of the bands' inverse transforms.
-    planner: FftPlanner<f64>,
     /// Spectra of the start of the sound (half the transform long), by transform length.
     spectra: Vec<(usize, Vec<Complex64>)>,
 }
@@ -136,8 +132,6 @@ impl<'a> Splitter<'a> {
         Self {
             x,
             sample_rate_hz,
-            real: RealFftPlanner::new(),
-            planner: FftPlanner::new(),
             spectra: Vec::new(),
         }
     }
@@ -155,7 +149,8 @@ impl<'a> Splitter<'a> {
         let index = match self.spectra.iter().position(|(n, _)| *n == fft_len) {
             Some(i) => i,
             None => {
-                let forward = self.real.plan_fft_forward(fft_len);
+                // A planner of its own, as for the bands' (see `band`).
+                let forward = RealFftPlanner::new().plan_fft_forward(fft_len);
                 let mut input = forward.make_input_vec();
                 input[..len].copy_from_slice(&self.x[..len]);
                 let mut spectrum = forward.make_output_vec();
@@ -167,14 +162,7 @@ impl<'a> Splitter<'a> {
             }
         };
         let bin_hz = self.sample_rate_hz / fft_len as f64;
-        band(
-            &self.spectra[index].1,
-            bin_hz,
-            fft_len,
-            len,
-            core,
-            &mut self.planner,
-        )
+        band(&self.spectra[index].1, bin_hz, fft_len, len, core)
     }
 }
 
@@ -220,7 +208,6 @@ fn band(
     fft_len: usize,
     len: usize,
     core_hz: (f64, f64),
-    planner: &mut FftPlanner<f64>,
 ) -> Band {
     let (flat, taper_hz, _) = shape(core_hz);
     let last_bin = spectrum.len() - 1;
@@ -245,7 +232,10 @@ fn band(
         .zip(&taper)
         .map(|(k, g)| spectrum.get(k).map_or(Complex64::new(0.0, 0.0), |v| v * g))
         .collect();
-    let inverse: Arc<dyn Fft<f64>> = planner.plan_fft_inverse(bins);
+    // A planner of its own: one that has planned other lengths may build this one from
+    // other parts, which changes the last bits, and the bank would depend on the order the
+    // bands are made in (and so on the number of threads making them).
+    let inverse: Arc<dyn Fft<f64>> = FftPlanner::new().plan_fft_inverse(bins);
     inverse.process(&mut buffer);
     let dt_s = 1.0 / (bins as f64 * bin_hz);
     let first = (SETTLE_TAPERS / (taper_hz * dt_s)).ceil() as usize;
