@@ -2,19 +2,20 @@
 //! over the corpus of `tests/common/corpus.rs`, both scored by the independent measure of
 //! `tests/common/fit_score.rs`.
 //!
-//! One row per recording: for each fitter the mean absolute dB difference between the recording
-//! and the re-synthesised modes over all frames, the attack (first 200 ms) and the tail, the
-//! number of modes, the median error in cents of the modes nearest the five strongest spectral
-//! peaks, and the fit's wall time. Then the means, how often the project's fitter scores lower,
-//! how many files score above 5 dB, and how many each refused.
+//! One row per recording: its length, then for each fitter the mean absolute dB difference
+//! between the recording and the re-synthesised modes over all frames, the attack (first
+//! 200 ms) and the tail, the number of modes, the median error in cents of the modes nearest the
+//! five strongest spectral peaks, and the fit's wall time. Then the means, how many files score
+//! above 5 dB, how many each refused, how the project's fitter's time compares with the length
+//! of the sound, and how often it scores lower.
 //!
 //! Run with `cargo bench --bench fit`. From the environment: `FIT_ONLY=slug,slug` (a subset),
 //! `FIT_CORPUS_DIR=DIR` (also write the recordings as WAV files there; empty for
 //! `target/fit-corpus`), and options for the project's fitter: `FIT_MODES`, `FIT_WINDOW_MS`,
 //! `FIT_MAX_SECONDS`, `FIT_NOISE_FLOOR_DB`, `FIT_THREADS` (1 unless given; 0 takes one per
-//! core). `FIT_SCORE_BANDS=1` prints, for each recording and
-//! fitter, the mean signed difference of the re-synthesis from the recording in each band of
-//! the score, over the attack and the tail: where a fit is too loud or too quiet.
+//! core). `FIT_SCORE_BANDS=1` prints, for each recording and fitter, the mean signed difference
+//! of the re-synthesis from the recording in each band of the score, over the attack and the
+//! tail: where a fit is too loud or too quiet.
 //!
 //! Without `--bench` (as `cargo test --benches` runs it) it decodes the whole corpus, checks every
 //! checksum and ending, and scores a few short recordings.

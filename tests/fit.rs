@@ -150,6 +150,14 @@ fn clean_render(bank: &Bank, k: usize) -> Vec<f64> {
     x
 }
 
+/// `bank` struck at `position` through the engine, with its default controls, for `compare`.
+fn engine(bank: &Bank, position: usize, sample_rate_hz: u32, len: usize) -> Vec<f64> {
+    resynthesize(bank, position, sample_rate_hz, len)
+        .into_iter()
+        .map(f64::from)
+        .collect()
+}
+
 /// The recording of position `k`: a lead-in, the render, and noise `snr_db` below it.
 fn noisy_recording(bank: &Bank, k: usize, snr_db: f64, seed: u64) -> Recording {
     let clean = clean_render(bank, k);
@@ -645,7 +653,7 @@ fn the_fidelity_score_tells_a_wrong_bank_from_the_right_one() {
         .map(|k| noisy_recording(&truth, k, SNR_DB, 90 + k as u64))
         .collect();
     let options = FitOptions::default();
-    let score = |bank: &Bank| compare(bank, &recordings, &options).unwrap();
+    let score = |bank: &Bank| compare(bank, &recordings, &options, engine).unwrap();
     let altered = |change: &dyn Fn(&mut Mode)| {
         let mut bank = truth.clone();
         bank.modes.iter_mut().for_each(change);

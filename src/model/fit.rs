@@ -7,8 +7,8 @@
 //! level over time to the recording's, in dB, and give the partials still missing a mode
 //! ([`levels`]). Then match modes across recordings and measure every mode's gain in every
 //! recording ([`combine`]), and score each recording against the bank re-synthesised at its
-//! position ([`fidelity`]). The noise spectrum ([`noise`]) and the per-mode tracks
-//! ([`track`]) feed the report.
+//! position ([`fidelity`]). The noise spectrum ([`noise`]) and the per-mode tracks ([`track`])
+//! feed the report.
 //!
 //! Gains are in the bank format's units: the amplitude, in full scale of the recording, of the
 //! mode at the strike, `y_k(t) = sum_n a_nk exp(-d_n t) sin(2 pi f_n t)`. The engine normalises a
@@ -248,12 +248,16 @@ pub fn fit_bank_with_progress(
 }
 
 /// How close `bank` comes to each of `recordings`: the log-spectral distance and level of the
-/// bank re-synthesised at the position named like the recording, as the fit's report gives it.
-/// For scoring a bank after editing, or a stored bank against the recordings it came from.
+/// bank re-synthesised by `resynthesize` (the bank, the position named like the recording, the
+/// recording's rate and length) as the fit's report gives them. For scoring a bank after
+/// editing, or a stored bank against the recordings it came from: `render::resynthesize`
+/// plays it as the engine does, with its default controls; [`synthesize_strike`] plays its
+/// modes alone.
 pub fn compare(
     bank: &Bank,
     recordings: &[Recording],
     options: &FitOptions,
+    resynthesize: impl Fn(&Bank, usize, u32, usize) -> Vec<f64>,
 ) -> Result<Vec<Fidelity>, FitError> {
     options.check()?;
     recordings
@@ -271,7 +275,8 @@ pub fn compare(
                 })?;
             let a = prepare(r, options)?;
             let max_hz = options.max_hz(r.sample_rate_hz);
-            Ok(fidelity(bank, position, &a, options.min_hz, max_hz))
+            let synth = resynthesize(bank, position, r.sample_rate_hz, a.signal.len());
+            Ok(fidelity(&synth, &a, options.min_hz, max_hz))
         })
         .collect()
 }
@@ -336,7 +341,8 @@ fn build_report(
         .map(|(k, a)| {
             let rate = a.sample_rate_hz;
             let max_hz = options.max_hz(rate as u32);
-            let score = fidelity(bank, k, a, options.min_hz, max_hz);
+            let synth = synthesize_strike(bank, k, rate as u32, a.signal.len());
+            let score = fidelity(&synth, a, options.min_hz, max_hz);
             let inside: Vec<Shape> = shapes
                 .iter()
                 .copied()

@@ -3,9 +3,10 @@
 //! band's signal, keeping as many as measurably improve its resynthesis
 //! ([`bandfit`](super::bandfit)).
 
-use realfft::num_complex::Complex64;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::mpsc;
+
+use realfft::num_complex::Complex64;
 
 use super::bandfit::{dedupe, fit_band, BandMode};
 use super::levels::match_levels;

@@ -15,7 +15,7 @@ use realfft::num_complex::Complex64;
 
 use super::analyse::Analysis;
 use super::stft::{hann, Spectrogram};
-use crate::dsp::coeffs::MAX_FREQ_RATIO;
+use crate::dsp::coeffs::{MAX_FREQ_RATIO, MIN_DECAY_PER_S};
 use crate::model::Bank;
 
 /// Length of the comparison's frames in seconds (rounded to a power of two of samples): about
@@ -39,10 +39,11 @@ pub struct Fidelity {
 }
 
 /// `bank` struck at position `position` with a unit impulse, `len` samples at
-/// `sample_rate_hz`, in the bank's own units: `sum_m a_m exp(-d_m t) sin(2 pi f_m t)`, as the
-/// engine plays it (`render::resynthesize` renders it through the engine, and the tests hold
-/// the two together). Modes the engine leaves out at this rate (at or above
-/// [`MAX_FREQ_RATIO`] of it) are left out.
+/// `sample_rate_hz`, in the bank's own units: `sum_m a_m exp(-d_m t) sin(2 pi f_m t)`. This is
+/// the bank as data, as a fitted bank plays (`render::resynthesize` renders any bank through
+/// the engine, with its default controls, and the tests hold the two together): modes at or
+/// above [`MAX_FREQ_RATIO`] of the rate are left out, and no mode decays slower than
+/// [`MIN_DECAY_PER_S`], as in the engine.
 pub fn synthesize_strike(
     bank: &Bank,
     position: usize,
@@ -57,8 +58,8 @@ pub fn synthesize_strike(
             continue;
         }
         // The mode's phasor, turned by its pole each sample: its imaginary part is the mode.
-        let pole =
-            Complex64::from_polar((-mode.decay_per_s / rate).exp(), TAU * mode.freq_hz / rate);
+        let decay_per_s = mode.decay_per_s.max(MIN_DECAY_PER_S);
+        let pole = Complex64::from_polar((-decay_per_s / rate).exp(), TAU * mode.freq_hz / rate);
         let mut z = Complex64::new(gain, 0.0);
         for v in &mut out {
             *v += z.im;
@@ -68,15 +69,14 @@ pub fn synthesize_strike(
     out
 }
 
-/// Compares the recording analysed in `a` with `bank` struck at `position`, over the sound of
-/// the recording and the bins between `min_hz` and `max_hz`.
-pub fn fidelity(bank: &Bank, position: usize, a: &Analysis, min_hz: f64, max_hz: f64) -> Fidelity {
+/// Compares the recording analysed in `a` with `synth`, a strike re-synthesised at the
+/// recording's rate and length, over the bins between `min_hz` and `max_hz`.
+pub fn fidelity(synth: &[f64], a: &Analysis, min_hz: f64, max_hz: f64) -> Fidelity {
     let rate = a.sample_rate_hz;
-    let synth = synthesize_strike(bank, position, rate as u32, a.signal.len());
     let len = ((FRAME_S * rate).log2().round().exp2() as usize).min(a.signal.len());
     let sum_sq: f64 = hann(len).iter().map(|w| w * w).sum();
     let rec = Spectrogram::new(&a.signal, rate, len, len / 2, 1);
-    let syn = Spectrogram::new(&synth, rate, len, len / 2, 1);
+    let syn = Spectrogram::new(synth, rate, len, len / 2, 1);
     let bins = rec.bin_of(min_hz)..rec.bin_of(max_hz) + 1;
     let loudest = rec
         .power
@@ -108,6 +108,6 @@ pub fn fidelity(bank: &Bank, position: usize, a: &Analysis, min_hz: f64, max_hz:
         } else {
             0.0
         },
-        level_db: 10.0 * (energy(&synth) / energy(&a.signal).max(1e-300)).log10(),
+        level_db: 10.0 * (energy(synth) / energy(&a.signal).max(1e-300)).log10(),
     }
 }
