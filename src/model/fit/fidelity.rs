@@ -1,5 +1,6 @@
-//! How close a bank sounds to a recording: the bank's modes re-synthesised at the recording's
-//! position, as the engine plays them, and compared with it spectrogram to spectrogram.
+//! How close a bank sounds to a recording: a strike of the bank at the recording's position,
+//! re-synthesised (its modes alone with [`synthesize_strike`], or through the engine by the
+//! caller), compared with the recording spectrogram to spectrogram.
 //!
 //! The score is the log-spectral distance over time: the RMS difference in dB between the two
 //! spectrograms, over the time-frequency cells where either stands above the recording's noise
