@@ -26,9 +26,9 @@ mod voice;
 use std::sync::Arc;
 
 pub use controls::{
-    ControlSpec, Controls, Material, ANALYSIS_FRAME_RANGE_MS, MASKING_OFFSET_RANGE_DB,
-    MATERIAL_Q_RANGE, MAX_MODE_BUDGET, MAX_POLYPHONY, MAX_TARGET_LOAD_PCT, NUMERIC_CONTROLS,
-    PLAYBACK_LEVEL_RANGE_DB_SPL,
+    control_range, ControlSpec, Controls, Material, ANALYSIS_FRAME_RANGE_MS,
+    MASKING_OFFSET_RANGE_DB, MATERIAL_Q_RANGE, MAX_MODE_BUDGET, MAX_POLYPHONY, MAX_TARGET_LOAD_PCT,
+    NUMERIC_CONTROLS, PLAYBACK_LEVEL_RANGE_DB_SPL,
 };
 pub use position::{PositionMap, PositionWeights, StrikeAxis};
 pub use prepared::{PreparedBank, TARGET_PEAK};

@@ -8,7 +8,9 @@ use nice_plug::params::persist::PersistentField;
 use nice_plug::prelude::*;
 
 use crate::dsp::ExciterKind;
-use crate::engine::{Controls, Material, VoiceModulation, MATERIAL_Q_RANGE, MAX_POLYPHONY};
+use crate::engine::{
+    control_range, Controls, Material, VoiceModulation, MATERIAL_Q_RANGE, MAX_POLYPHONY,
+};
 use crate::model::factory::factory_bank;
 use crate::plugin::DEFAULT_FACTORY_BANK;
 
@@ -313,8 +315,17 @@ fn percent(name: &str, default: f32) -> FloatParam {
         .with_string_to_value(formatters::s2v_f32_percentage())
 }
 
-fn decibels(name: &str, default: f32, min: f32, max: f32) -> FloatParam {
-    FloatParam::new(name, default, FloatRange::Linear { min, max })
+/// Range of the onset trigger's threshold in dB: the input mode's own, with no engine control.
+const TRIGGER_THRESHOLD_RANGE_DB: (f32, f32) = (-80.0, 0.0);
+
+/// A linear range from `(min, max)`.
+fn linear((min, max): (f32, f32)) -> FloatRange {
+    FloatRange::Linear { min, max }
+}
+
+/// A level in dB over `range`, in steps of 0.1 dB.
+fn decibels(name: &str, default: f32, range: (f32, f32)) -> FloatParam {
+    FloatParam::new(name, default, linear(range))
         .with_unit(" dB")
         .with_step_size(0.1)
 }
@@ -335,8 +346,8 @@ impl ModalParams {
                     "Size",
                     1.0,
                     FloatRange::SymmetricalSkewed {
-                        min: 0.25,
-                        max: 4.0,
+                        min: control_range("size_ratio").0,
+                        max: control_range("size_ratio").1,
                         factor: FloatRange::skew_factor(-1.0),
                         center: 1.0,
                     },
@@ -349,10 +360,7 @@ impl ModalParams {
                 fine_tune: FloatParam::new(
                     "Fine tune",
                     0.0,
-                    FloatRange::Linear {
-                        min: -100.0,
-                        max: 100.0,
-                    },
+                    linear(control_range("fine_tune_cents")),
                 )
                 .with_unit(" ct")
                 .with_step_size(0.1)
@@ -362,7 +370,7 @@ impl ModalParams {
                     2.0,
                     FloatRange::Linear {
                         min: 0.0,
-                        max: 48.0,
+                        max: control_range("pitch_bend_semitones").1,
                     },
                 )
                 .with_unit(" st")
@@ -379,8 +387,8 @@ impl ModalParams {
                     "Hardness",
                     d.hardness_ms,
                     FloatRange::Skewed {
-                        min: 0.05,
-                        max: 20.0,
+                        min: control_range("hardness_ms").0,
+                        max: control_range("hardness_ms").1,
                         factor: FloatRange::skew_factor(-2.5),
                     },
                 )
@@ -405,10 +413,7 @@ impl ModalParams {
                 damping_tilt: FloatParam::new(
                     "Damping tilt",
                     d.damping_tilt,
-                    FloatRange::Linear {
-                        min: -2.0,
-                        max: 2.0,
-                    },
+                    linear(control_range("damping_tilt")),
                 )
                 .with_step_size(0.01),
                 release_damping: percent("Release damping", 0.0),
@@ -422,7 +427,11 @@ impl ModalParams {
                         max: MAX_POLYPHONY as i32,
                     },
                 ),
-                truncation: decibels("Truncation threshold", -96.0, -140.0, -60.0),
+                truncation: decibels(
+                    "Truncation threshold",
+                    -96.0,
+                    control_range("truncation_db"),
+                ),
                 mod_wheel_target: EnumParam::new("Mod wheel", ExpressionTarget::Position),
                 pressure_target: EnumParam::new("Pressure", ExpressionTarget::Damping),
                 mpe: BoolParam::new("MPE", false),
@@ -438,7 +447,7 @@ impl ModalParams {
                 .with_step_size(1.0),
             },
             output: OutputParams {
-                output_gain: decibels("Output gain", 0.0, -60.0, 12.0),
+                output_gain: decibels("Output gain", 0.0, control_range("output_gain_db")),
                 width: percent("Stereo width", 0.5),
                 dry_wet: percent("Dry/wet", if is_effect { 0.5 } else { 1.0 }),
             },
@@ -454,10 +463,9 @@ impl ModalParams {
                 input_gain: decibels(
                     "Input gain",
                     if is_effect { -24.0 } else { 0.0 },
-                    -60.0,
-                    24.0,
+                    control_range("input_gain_db"),
                 ),
-                trigger_threshold: decibels("Trigger threshold", -30.0, -80.0, 0.0),
+                trigger_threshold: decibels("Trigger threshold", -30.0, TRIGGER_THRESHOLD_RANGE_DB),
                 retrigger: FloatParam::new(
                     "Retrigger time",
                     50.0,
@@ -570,6 +578,38 @@ impl ModalParams {
             output_gain_db: self.output.output_gain.value(),
             input_gain_db: self.input.input_gain.value(),
             ..self.pruning.apply(Controls::default())
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each host parameter that sets a numeric control spans that control's range.
+    #[test]
+    fn parameters_span_their_controls_ranges() {
+        for is_effect in [false, true] {
+            let p = ModalParams::new(is_effect);
+            for (param, control) in [
+                (&p.object.size, "size_ratio"),
+                (&p.object.fine_tune, "fine_tune_cents"),
+                (&p.strike.hardness, "hardness_ms"),
+                (&p.material.damping_tilt, "damping_tilt"),
+                (&p.voices.truncation, "truncation_db"),
+                (&p.output.output_gain, "output_gain_db"),
+                (&p.input.input_gain, "input_gain_db"),
+                (&p.pruning.masking_offset, "masking_offset_db"),
+                (&p.pruning.playback_level, "playback_level_db_spl"),
+            ] {
+                let (min, max) = control_range(control);
+                let ends = (param.preview_plain(0.0), param.preview_plain(1.0));
+                assert_eq!(ends, (min, max), "{} and {control}", param.name());
+            }
+            assert_eq!(
+                p.object.bend_range.preview_plain(1.0),
+                control_range("pitch_bend_semitones").1
+            );
         }
     }
 }

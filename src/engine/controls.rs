@@ -289,6 +289,20 @@ pub const NUMERIC_CONTROLS: &[ControlSpec] = &[
     ),
 ];
 
+/// The range of the numeric control `name` (see [`NUMERIC_CONTROLS`]), where the host
+/// parameters take theirs from, so each range is written once.
+///
+/// # Panics
+/// If no numeric control has that name: a programming error, caught by the first test that
+/// builds the parameters.
+pub fn control_range(name: &str) -> (f32, f32) {
+    let spec = NUMERIC_CONTROLS
+        .iter()
+        .find(|s| s.name == name)
+        .unwrap_or_else(|| panic!("no numeric control named {name}"));
+    (spec.min, spec.max)
+}
+
 /// Range of the masking offset `a_v` in dB (seed 001 found 5 dB transparent, 20 dB the
 /// laboratory figure for tone-on-tone masking).
 pub const MASKING_OFFSET_RANGE_DB: (f32, f32) = (0.0, 20.0);

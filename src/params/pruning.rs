@@ -44,14 +44,12 @@ impl PruningParams {
             masking_offset: decibels(
                 "Masking offset",
                 controls.masking_offset_db,
-                MASKING_OFFSET_RANGE_DB.0,
-                MASKING_OFFSET_RANGE_DB.1,
+                MASKING_OFFSET_RANGE_DB,
             ),
             playback_level: decibels(
                 "Playback level",
                 controls.playback_level_db_spl,
-                PLAYBACK_LEVEL_RANGE_DB_SPL.0,
-                PLAYBACK_LEVEL_RANGE_DB_SPL.1,
+                PLAYBACK_LEVEL_RANGE_DB_SPL,
             )
             .with_unit(" dB SPL"),
             analysis_frame: FloatParam::new(
