@@ -11,8 +11,7 @@ use crate::dsp::ExciterKind;
 use crate::engine::{
     control_range, Controls, Material, VoiceModulation, MATERIAL_Q_RANGE, MAX_POLYPHONY,
 };
-use crate::model::factory::factory_bank;
-use crate::plugin::DEFAULT_FACTORY_BANK;
+use crate::model::factory::{factory_bank, DEFAULT_FACTORY_BANK};
 
 mod pruning;
 

@@ -945,7 +945,7 @@ fn a_bank_swap_fades_the_ringing_bank_out_without_a_click() {
 fn the_default_bank_peaks_near_minus_6_dbfs_at_its_root() {
     // Default parameters strike the default bank at its typical point with its own mallet.
     let bank = modal_resonator::model::factory::factory_bank(
-        modal_resonator::plugin::DEFAULT_FACTORY_BANK,
+        modal_resonator::model::factory::DEFAULT_FACTORY_BANK,
     )
     .unwrap();
     let root = modal_resonator::units::hz_to_midi_key(bank.effective_root_hz()).round() as u16;

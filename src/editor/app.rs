@@ -20,9 +20,9 @@ use super::strike_pad::StrikePad;
 use super::window_size::WindowSize;
 use super::{bank_info, mode_editor, params_panel, style};
 use super::{Audition, EditorLinks, EditorShared, MeterReading, METER_INTERVAL_S};
+use crate::model::factory::bank_from_state;
 use crate::model::summary::BankSummary;
 use crate::params::ModalParams;
-use crate::plugin::bank_from_state;
 
 mod flow;
 

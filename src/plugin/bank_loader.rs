@@ -1,13 +1,9 @@
-//! Turning the bank saved in the plugin state into a ready engine, off the audio thread.
+//! Building the engine for the bank the plugin state holds, off the audio thread.
 
 use std::sync::Arc;
 
 use crate::engine::{Engine, PreparedBank};
-use crate::model::factory::factory_bank;
-use crate::model::{parse_bank_str, Bank};
-
-/// The factory bank played when the state holds none.
-pub const DEFAULT_FACTORY_BANK: &str = "rosewood-marimba-bar";
+use crate::model::Bank;
 
 /// An engine built for a bank, on its way to the audio thread.
 pub struct LoadedEngine {
@@ -17,15 +13,6 @@ pub struct LoadedEngine {
     pub epoch: u64,
     /// The engine, prepared for the current sample rate.
     pub engine: Box<Engine>,
-}
-
-/// The bank saved as `json` (the default factory bank when empty). Errors name what is wrong.
-pub fn bank_from_state(json: &str) -> Result<Bank, String> {
-    if json.trim().is_empty() {
-        return factory_bank(DEFAULT_FACTORY_BANK)
-            .ok_or_else(|| format!("factory bank {DEFAULT_FACTORY_BANK} is missing"));
-    }
-    parse_bank_str(json, "saved bank").map_err(|e| e.to_string())
 }
 
 /// An engine playing `bank` with voices for `polyphony` notes at once, prepared for

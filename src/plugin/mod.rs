@@ -17,13 +17,14 @@ use nice_plug::plugin::ParamValue;
 use nice_plug::prelude::*;
 use nice_plug_egui::{EguiEditor, EguiEditorState};
 
-pub use bank_loader::{bank_from_state, build_engine, LoadedEngine, DEFAULT_FACTORY_BANK};
+pub use bank_loader::{build_engine, LoadedEngine};
 pub use kind::{Effect, Instrument, Kind};
 
 use crate::dsp::denormal::flush_subnormals;
 use crate::dsp::onset::OnsetDetector;
 use crate::editor::{self, EditorApp, EditorLinks, EditorShared, AUDITION_NOTE_ID};
 use crate::engine::{EndedVoice, NoteEvent as EngineEvent, PositionMap, MAX_POLYPHONY};
+use crate::model::factory::bank_from_state;
 use crate::params::{InputMode, ModalParams, STATE_FORMAT, STATE_FORMAT_FIELD};
 use engines::Engines;
 use events::{ControlChange, Expression};

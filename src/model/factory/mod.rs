@@ -17,7 +17,7 @@ pub use table::factory_table_markdown;
 
 use crate::model::materials::Material;
 use crate::model::shapes::{design_bank, BankDesign, ModeLimits, Shape};
-use crate::model::Bank;
+use crate::model::{parse_bank_str, Bank};
 use crate::units::midi_key_to_hz;
 use fitted::{FittedPreset, FITTED_PRESETS};
 use std::path::{Path, PathBuf};
@@ -178,6 +178,19 @@ fn slugify(name: &str) -> String {
         slug.pop();
     }
     slug
+}
+
+/// The factory bank played when a plugin's state holds none.
+pub const DEFAULT_FACTORY_BANK: &str = "rosewood-marimba-bar";
+
+/// The bank a plugin's state saved as `json` (the default factory bank when empty). Errors name
+/// what is wrong.
+pub fn bank_from_state(json: &str) -> Result<Bank, String> {
+    if json.trim().is_empty() {
+        return factory_bank(DEFAULT_FACTORY_BANK)
+            .ok_or_else(|| format!("factory bank {DEFAULT_FACTORY_BANK} is missing"));
+    }
+    parse_bank_str(json, "saved bank").map_err(|e| e.to_string())
 }
 
 /// The factory bank with this name (any case) or slug; a fitted bank also by its file's name
