@@ -32,7 +32,7 @@ use realfft::num_complex::Complex64;
 use rustfft::{Fft, FftPlanner};
 
 use super::closed_form::{self, Lanes};
-use super::linalg::{dot, solve};
+use super::linalg::{dots, solve, BLOCK};
 use super::subband::Band;
 
 /// Iterations of Levenberg-Marquardt.
@@ -432,46 +432,73 @@ impl<'a> Target<'a> {
         let m = self.range.len();
         let mut buffers = self.jacobian.borrow_mut();
         let (jacobian, residual) = &mut *buffers;
-        jacobian.clear();
+        // Every entry is written below.
         jacobian.resize(dim * 2 * m, 0.0);
-        residual.clear();
         residual.resize(2 * m, 0.0);
-        let mut put = |column: usize, i: usize, v: Complex64| {
-            jacobian[column * 2 * m + i] = v.re;
-            jacobian[column * 2 * m + m + i] = v.im;
-        };
-        for (i, (n, &w)) in self.range.clone().zip(&self.weights).enumerate() {
-            let model: Complex64 = cols
-                .iter()
-                .zip(modes)
-                .map(|(c, m)| c.unit[i] * m.gain)
-                .sum();
-            let r = (self.band.samples[n] - model) * w;
-            (residual[i], residual[m + i]) = (r.re, r.im);
-            for (k, (c, mode)) in cols.iter().zip(modes).enumerate() {
-                put(PARAMS * k, i, c.d_log_magnitude[i] * (mode.gain * w));
-                put(PARAMS * k + 1, i, c.d_angle[i] * (mode.gain * w));
-                put(PARAMS * k + 2, i, c.unit[i] * w);
-            }
-            put(dim - 1, i, d_tau[i] * w);
+        let (re, im) = residual.split_at_mut(m);
+        for ((n, &w), (re, im)) in self.range.clone().zip(&self.weights).zip(re.iter_mut().zip(im)) {
+            (*re, *im) = (self.band.samples[n].re * w, self.band.samples[n].im * w);
         }
+        // Column by column, each written from start to end: `values` times `scale` and the
+        // weights.
+        let weights = &self.weights;
+        let mut put = |column: usize, values: &[Complex64], scale: f64| {
+            let (re, im) = jacobian[column * 2 * m..(column + 1) * 2 * m].split_at_mut(m);
+            for (((re, im), v), w) in re.iter_mut().zip(im).zip(values).zip(weights) {
+                let v = v * (scale * w);
+                (*re, *im) = (v.re, v.im);
+            }
+        };
+        for (k, (c, mode)) in cols.iter().zip(modes).enumerate() {
+            put(PARAMS * k, &c.d_log_magnitude, mode.gain);
+            put(PARAMS * k + 1, &c.d_angle, mode.gain);
+            put(PARAMS * k + 2, &c.unit, 1.0);
+            let (re, im) = residual.split_at_mut(m);
+            for (((re, im), u), w) in re.iter_mut().zip(im).zip(&c.unit).zip(weights) {
+                let v = u * (mode.gain * w);
+                *re -= v.re;
+                *im -= v.im;
+            }
+        }
+        put(dim - 1, &d_tau, 1.0);
         // By stretches of rows short enough that every column's stretch stays in the cache
-        // while it meets the others.
-        let mut normal = vec![0.0; dim * dim];
-        let mut gradient = vec![0.0; dim];
+        // while it meets the others, and by blocks of columns, each loaded once for several
+        // products. The residual is the last column: its products are the gradient.
+        let columns = dim + 1;
+        let mut products = vec![0.0; columns * columns];
         for start in (0..2 * m).step_by(ROWS_AT_ONCE) {
             let rows = start..(start + ROWS_AT_ONCE).min(2 * m);
-            let column = |a: usize| &jacobian[a * 2 * m..(a + 1) * 2 * m][rows.clone()];
-            for a in 0..dim {
-                gradient[a] += dot(column(a), &residual[rows.clone()]);
-                for b in a..dim {
-                    normal[a * dim + b] += dot(column(a), column(b));
+            let column = |a: usize| {
+                let a = a.min(columns - 1);
+                if a == dim {
+                    &residual[rows.clone()]
+                } else {
+                    &jacobian[a * 2 * m..(a + 1) * 2 * m][rows.clone()]
+                }
+            };
+            for a in (0..columns).step_by(BLOCK.0) {
+                for b in (a - a % BLOCK.1..columns).step_by(BLOCK.1) {
+                    let block = dots(
+                        std::array::from_fn(|i| column(a + i)),
+                        std::array::from_fn(|j| column(b + j)),
+                    );
+                    for (i, row) in block.iter().enumerate() {
+                        for (j, v) in row.iter().enumerate() {
+                            let (p, q) = (a + i, b + j);
+                            if p <= q && q < columns {
+                                products[p * columns + q] += v;
+                            }
+                        }
+                    }
                 }
             }
         }
+        let mut normal = vec![0.0; dim * dim];
+        let mut gradient = vec![0.0; dim];
         for a in 0..dim {
-            for b in 0..a {
-                normal[a * dim + b] = normal[b * dim + a];
+            gradient[a] = products[a * columns + dim];
+            for b in 0..dim {
+                normal[a * dim + b] = products[a.min(b) * columns + a.max(b)];
             }
         }
         (normal, gradient)
