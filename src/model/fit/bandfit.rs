@@ -18,7 +18,8 @@ const MAX_ESPRIT_SAMPLES: usize = 4096;
 const MAX_FIT_SAMPLES: usize = 6000;
 
 /// A band is made at least this many times as long as the samples it fits (and the stretch
-/// the band filter smears), so that its transform's wrap-around stays clear of them.
+/// the band filter smears): the sound goes on past them, so the band filter's smear of the
+/// place it is cut off stays clear of them.
 const SPARE_LENGTH: f64 = 1.5;
 
 /// Span of the running mean of the band's power that weights the refinement, in seconds.
