@@ -53,7 +53,7 @@ const SLOW_NEPERS: f64 = 1.0;
 const BEFORE_SHARE: f64 = 0.5;
 
 /// A mode with this many dB less energy than the strongest is left out.
-const INAUDIBLE_DB: f64 = 70.0;
+pub(super) const INAUDIBLE_DB: f64 = 70.0;
 
 /// Longest stretch before the onset kept to look for hum, in seconds.
 const BEFORE_S: f64 = 1.0;

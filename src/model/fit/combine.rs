@@ -9,7 +9,7 @@
 
 use realfft::num_complex::Complex64;
 
-use super::analyse::Analysis;
+use super::analyse::{Analysis, INAUDIBLE_DB};
 use super::lsq::Shape;
 use super::track::Track;
 use crate::dsp::coeffs::MIN_DECAY_PER_S;
@@ -124,6 +124,12 @@ pub fn combine(analyses: &[Analysis], max_modes: usize) -> Vec<Combined> {
         measure_gains(analyses, &mut modes);
     }
     modes.retain(|m| m.gains.iter().any(|&g| g != 0.0));
+    // The bank keeps the analysis' rule for inaudible modes: gains measured again over several
+    // recordings can leave one far below the others (a click dying within a millisecond, its
+    // gain taken from the start of each recording).
+    let loudest = modes.iter().map(energy).fold(0.0, f64::max);
+    let floor = loudest * 10f64.powf(-INAUDIBLE_DB / 10.0);
+    modes.retain(|m| energy(m) >= floor);
     if modes.len() > max_modes {
         modes.sort_by(|a, b| energy(b).total_cmp(&energy(a)));
         modes.truncate(max_modes);
