@@ -7,8 +7,18 @@ use super::esprit::{esprit, Estimate, MIN_SAMPLES};
 use super::refine::{Exp, Modes, Target};
 use super::subband::{log_pole, Band, Splitter};
 
-/// Most modes a band may hold (its core spans about two semitones).
+/// Most modes a band may hold when its core spans about two semitones...
 const MAX_ORDER: usize = 14;
+
+/// ... and at most when it spans more (the cores of one width at low frequencies, where a drum
+/// or a timpani packs its partials closest).
+const MAX_ORDER_WIDE: usize = 24;
+
+/// Most modes the band of `core` may hold: [`MAX_ORDER`] per two semitones.
+fn max_order(core: (f64, f64)) -> usize {
+    let semitones = 12.0 * (core.1 / core.0).log2();
+    ((MAX_ORDER as f64 * semitones / 2.0).round() as usize).clamp(MAX_ORDER, MAX_ORDER_WIDE)
+}
 
 /// Most samples of a band ESPRIT's covariance is taken over: the first of them clear of the
 /// band filter's smear of the onset, where the modes are loudest.
@@ -238,7 +248,10 @@ fn measure(band: &Band) -> Option<(Estimate, usize)> {
         return None;
     }
     let data = &y[band.first..];
-    let estimate = esprit(&data[..data.len().min(MAX_ESPRIT_SAMPLES)], MAX_ORDER)?;
+    let estimate = esprit(
+        &data[..data.len().min(MAX_ESPRIT_SAMPLES)],
+        max_order(band.core_hz),
+    )?;
     let end = sound_end(y, 0, smoothing(band), estimate.noise_var)
         .min(MAX_FIT_SAMPLES)
         .max(band.first + MIN_SAMPLES);

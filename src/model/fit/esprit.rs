@@ -12,7 +12,8 @@ use realfft::num_complex::Complex64;
 
 use super::linalg::{eigenvalues, hermitian_eigen, solve};
 
-/// Rows of the data vectors: at least twice the most modes a band may hold.
+/// Rows of the data vectors: well above the most modes a band may hold (24, see
+/// [`bandfit`](super::bandfit)).
 const MAX_ROWS: usize = 40;
 
 /// An eigenvalue counts as a mode when it stands this many times above the noise's.

@@ -126,7 +126,12 @@ pub fn add_modes(out: &mut [f64], sample_rate_hz: f64, shapes: &[Shape], amplitu
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn add_modes_avx2(out: &mut [f64], sample_rate_hz: f64, shapes: &[Shape], amplitudes: &[Complex64]) {
+fn add_modes_avx2(
+    out: &mut [f64],
+    sample_rate_hz: f64,
+    shapes: &[Shape],
+    amplitudes: &[Complex64],
+) {
     add_modes_portable(out, sample_rate_hz, shapes, amplitudes);
 }
 

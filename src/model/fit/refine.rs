@@ -436,7 +436,12 @@ impl<'a> Target<'a> {
         jacobian.resize(dim * 2 * m, 0.0);
         residual.resize(2 * m, 0.0);
         let (re, im) = residual.split_at_mut(m);
-        for ((n, &w), (re, im)) in self.range.clone().zip(&self.weights).zip(re.iter_mut().zip(im)) {
+        for ((n, &w), (re, im)) in self
+            .range
+            .clone()
+            .zip(&self.weights)
+            .zip(re.iter_mut().zip(im))
+        {
             (*re, *im) = (self.band.samples[n].re * w, self.band.samples[n].im * w);
         }
         // Column by column, each written from start to end: `values` times `scale` and the
