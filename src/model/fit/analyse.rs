@@ -42,8 +42,10 @@ const PAD: usize = 2;
 const STEADY_NEPERS: f64 = 0.05;
 
 /// Shortest sound, in seconds, over which a mode that does not decay is taken for hum without
-/// hearing it before the strike: over less, a slow mode of the object seems as steady.
-const MIN_STEADY_S: f64 = 3.0;
+/// hearing it before the strike: over 2 s it would take more than four minutes to fall by
+/// 60 dB, which no struck object in air rings for; over less, a slow mode of the object may
+/// seem as steady (a glockenspiel sampled for 1.3 s has one).
+const MIN_STEADY_S: f64 = 2.0;
 
 /// A mode falling by less than this many nepers over the recording is hum when it is already
 /// there before the strike...
@@ -301,15 +303,20 @@ fn find_modes(a: &mut Analysis, options: &FitOptions, max_hz: f64, progress: &mu
 /// strongest mode's: a rounding error of the fit, never heard beside it. `shape` gives a mode's
 /// complex amplitude and decay.
 fn drop_inaudible<T>(modes: &mut Vec<T>, sound_s: f64, shape: impl Fn(&T) -> (Complex64, f64)) {
-    // The energy of a |a| exp(-d t) envelope over the sound: |a|^2 (1 - exp(-2 d T)) / (2 d).
     let energy = |m: &T| {
         let (amplitude, decay) = shape(m);
-        let d = decay.max(1e-9);
-        amplitude.norm_sqr() * -(-2.0 * d * sound_s).exp_m1() / (2.0 * d)
+        energy_over(amplitude.norm(), decay, sound_s)
     };
     let loudest = modes.iter().map(&energy).fold(0.0, f64::max);
     let floor = loudest * 10f64.powf(-INAUDIBLE_DB / 10.0);
     modes.retain(|m| energy(m) >= floor);
+}
+
+/// The energy of an `amplitude exp(-decay t)` envelope over `sound_s` seconds:
+/// `a^2 (1 - exp(-2 d T)) / (2 d)`.
+pub(super) fn energy_over(amplitude: f64, decay_per_s: f64, sound_s: f64) -> f64 {
+    let d = decay_per_s.max(1e-9);
+    amplitude * amplitude * -(-2.0 * d * sound_s).exp_m1() / (2.0 * d)
 }
 
 /// For the report, each mode followed alone in the recording less every other mode: the frames

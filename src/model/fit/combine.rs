@@ -9,7 +9,7 @@
 
 use realfft::num_complex::Complex64;
 
-use super::analyse::{Analysis, INAUDIBLE_DB};
+use super::analyse::{energy_over, Analysis, INAUDIBLE_DB};
 use super::lsq::Shape;
 use super::track::Track;
 use crate::dsp::coeffs::MIN_DECAY_PER_S;
@@ -124,12 +124,21 @@ pub fn combine(analyses: &[Analysis], max_modes: usize) -> Vec<Combined> {
         measure_gains(analyses, &mut modes);
     }
     modes.retain(|m| m.gains.iter().any(|&g| g != 0.0));
-    // The bank keeps the analysis' rule for inaudible modes: gains measured again over several
-    // recordings can leave one far below the others (a click dying within a millisecond, its
-    // gain taken from the start of each recording).
-    let loudest = modes.iter().map(energy).fold(0.0, f64::max);
+    // The bank keeps the analysis' rule for inaudible modes (energy over the sound, the longest
+    // recording's here): gains measured again over several recordings can leave one far below
+    // the others (a click dying within a millisecond, its gain taken from the start of each
+    // recording).
+    let sound_s = analyses
+        .iter()
+        .map(|a| a.signal.len() as f64 / a.sample_rate_hz)
+        .fold(0.0, f64::max);
+    let heard = |m: &Combined| {
+        let a = m.gains.iter().fold(0.0f64, |acc, g| acc.max(g.abs()));
+        energy_over(a, m.decay_per_s, sound_s)
+    };
+    let loudest = modes.iter().map(heard).fold(0.0, f64::max);
     let floor = loudest * 10f64.powf(-INAUDIBLE_DB / 10.0);
-    modes.retain(|m| energy(m) >= floor);
+    modes.retain(|m| heard(m) >= floor);
     if modes.len() > max_modes {
         modes.sort_by(|a, b| energy(b).total_cmp(&energy(a)));
         modes.truncate(max_modes);
