@@ -73,7 +73,8 @@ pub fn find_strike(x: &[f64], sample_rate_hz: f64) -> Result<Strike, String> {
                 "no strike: the sound neither rises out of quiet (the loudest part is only \
                  {snr_db:.1} dB above the quietest, {MIN_STRIKE_DB} dB is needed) nor decays \
                  (its loudest 10 ms are {decay_db:.1} dB above its last quarter, \
-                 {MIN_DECAY_DB} dB is needed): steady noise or a held tone?"
+                 {MIN_DECAY_DB} dB is needed): {}",
+                steady_sound(x, sample_rate_hz)
             ));
         }
     }
@@ -99,6 +100,74 @@ pub fn find_strike(x: &[f64], sample_rate_hz: f64) -> Result<Strike, String> {
         noise_rms,
         snr_db,
     })
+}
+
+/// Length of the frames a steady sound's spectrum is averaged over, in seconds.
+const STEADY_FRAME_S: f64 = 0.085;
+
+/// A bin is part of a tone when its averaged power stands this many dB above the median of
+/// the bins around it.
+const TONE_ABOVE_LOCAL_DB: f64 = 15.0;
+
+/// Bins either side of a bin that make up its surroundings.
+const LOCAL_BINS: usize = 32;
+
+/// A steady sound is a held tone when this share of its power is in tones.
+const TONAL_SHARE: f64 = 0.5;
+
+/// What a sound with no strike is, in words: a held tone (named by its strongest frequency)
+/// when most of its power stands in narrow peaks well above the spectrum around them, steady
+/// noise otherwise. The spectrum is averaged over overlapping frames, so noise varies by about
+/// a decibel from bin to bin and never makes such peaks.
+fn steady_sound(x: &[f64], sample_rate_hz: f64) -> String {
+    let frame = ((STEADY_FRAME_S * sample_rate_hz) as usize).next_power_of_two();
+    if x.len() < frame {
+        return "steady noise or a held tone, too short to tell which".to_string();
+    }
+    let frames = super::stft::Spectrogram::new(x, sample_rate_hz, frame, frame / 2, 1);
+    let mut mean = vec![0.0; frames.num_bins()];
+    for power in &frames.power {
+        for (m, p) in mean.iter_mut().zip(power) {
+            *m += p;
+        }
+    }
+    let total: f64 = mean.iter().sum();
+    if total <= 0.0 {
+        return "steady noise or a held tone".to_string();
+    }
+    let above = 10f64.powf(TONE_ABOVE_LOCAL_DB / 10.0);
+    let mut tonal = vec![false; mean.len()];
+    let mut around = Vec::with_capacity(2 * LOCAL_BINS + 1);
+    for k in 0..mean.len() {
+        around.clear();
+        around.extend_from_slice(
+            &mean[k.saturating_sub(LOCAL_BINS)..(k + LOCAL_BINS + 1).min(mean.len())],
+        );
+        let mid = around.len() / 2;
+        let (_, median, _) = around.select_nth_unstable_by(mid, f64::total_cmp);
+        if mean[k] > above * *median {
+            // The window's main lobe: the peak and the bins either side of it.
+            for t in &mut tonal[k.saturating_sub(2)..(k + 3).min(mean.len())] {
+                *t = true;
+            }
+        }
+    }
+    let in_tones: f64 = mean
+        .iter()
+        .zip(&tonal)
+        .filter(|(_, t)| **t)
+        .map(|(p, _)| p)
+        .sum();
+    if in_tones / total < TONAL_SHARE {
+        return "it is steady noise".to_string();
+    }
+    let strongest = (0..mean.len())
+        .max_by(|&a, &b| mean[a].total_cmp(&mean[b]))
+        .expect("a spectrum has bins");
+    format!(
+        "it is a held tone (strongest near {:.0} Hz)",
+        strongest as f64 * frames.bin_hz
+    )
 }
 
 /// Mean square of `x` in blocks of `block` samples.
@@ -207,11 +276,42 @@ mod tests {
         let mut rng = Rng::new(9);
         let noise: Vec<f64> = (0..48_000).map(|_| 0.1 * rng.bipolar() as f64).collect();
         let message = find_strike(&noise, 48_000.0).unwrap_err();
-        assert!(message.contains("steady noise or a held tone"), "{message}");
+        assert!(message.contains("it is steady noise"), "{message}");
+        // Coloured noise (white noise through a one-pole low-pass) is noise too.
+        let mut state = 0.0;
+        let pink: Vec<f64> = noise
+            .iter()
+            .map(|v| {
+                state = 0.7 * state + v;
+                state
+            })
+            .collect();
+        let message = find_strike(&pink, 48_000.0).unwrap_err();
+        assert!(message.contains("it is steady noise"), "{message}");
+        // A held tone with harmonics over a little noise: named, with its strongest frequency.
         let tone: Vec<f64> = (0..48_000)
-            .map(|n| (std::f64::consts::TAU * 440.0 * n as f64 / 48_000.0).sin())
+            .map(|n| {
+                let phase = std::f64::consts::TAU * 440.0 * n as f64 / 48_000.0;
+                phase.sin()
+                    + 0.5 * (2.0 * phase).sin()
+                    + 0.25 * (3.0 * phase).sin()
+                    + 0.01 * rng.bipolar() as f64
+            })
             .collect();
         let message = find_strike(&tone, 48_000.0).unwrap_err();
         assert!(message.contains("nor decays"), "{message}");
+        assert!(
+            message.contains("it is a held tone (strongest near 4"),
+            "{message}"
+        );
+        // Hum: a mains tone under hiss.
+        let hum: Vec<f64> = (0..48_000)
+            .map(|n| {
+                0.1 * (std::f64::consts::TAU * 60.0 * n as f64 / 48_000.0).sin()
+                    + 0.02 * rng.bipolar() as f64
+            })
+            .collect();
+        let message = find_strike(&hum, 48_000.0).unwrap_err();
+        assert!(message.contains("held tone (strongest near 5"), "{message}");
     }
 }
