@@ -17,6 +17,7 @@
 
 mod budget;
 mod controls;
+mod mix;
 mod position;
 mod prepared;
 mod pruning;
@@ -29,6 +30,9 @@ pub use controls::{
     control_range, ControlSpec, Controls, Material, ANALYSIS_FRAME_RANGE_MS,
     MASKING_OFFSET_RANGE_DB, MATERIAL_Q_RANGE, MAX_MODE_BUDGET, MAX_POLYPHONY, MAX_TARGET_LOAD_PCT,
     NUMERIC_CONTROLS, PLAYBACK_LEVEL_RANGE_DB_SPL,
+};
+pub use mix::{
+    mix_to_mono, Bypass, DryWet, FadeOut, OnsetTrigger, BANK_CROSSFADE_S, BYPASS_FADE_S,
 };
 pub use position::{PositionMap, PositionWeights, StrikeAxis};
 pub use prepared::{PreparedBank, TARGET_PEAK};

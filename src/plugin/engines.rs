@@ -5,7 +5,7 @@
 use crossbeam_channel::{Receiver, Sender};
 
 use super::bank_loader::LoadedEngine;
-use crate::engine::{Engine, Note, MAX_POLYPHONY};
+use crate::engine::{Engine, FadeOut, Note, MAX_POLYPHONY};
 
 /// Engines handed to the background thread at once, before one waits for room.
 const TRASH_CAPACITY: usize = 8;
@@ -32,8 +32,8 @@ pub struct BackgroundEnds {
 pub struct Outgoing {
     /// The engine.
     pub engine: Box<Engine>,
-    /// Its gain now, 1 down to 0.
-    pub gain: f32,
+    /// Its fade to silence.
+    pub fade: FadeOut,
 }
 
 /// The audio thread's engines.
@@ -165,7 +165,7 @@ impl Engines {
                         // A fade already under way is cut short by the newer swap.
                         let cut = self.outgoing.replace(Outgoing {
                             engine: old,
-                            gain: 1.0,
+                            fade: FadeOut::new(),
                         });
                         cut.map(|o| o.engine)
                     }

@@ -21,9 +21,11 @@ pub use bank_loader::{build_engine, LoadedEngine};
 pub use kind::{Effect, Instrument, Kind};
 
 use crate::dsp::denormal::flush_subnormals;
-use crate::dsp::onset::OnsetDetector;
 use crate::editor::{self, EditorApp, EditorLinks, EditorShared, AUDITION_NOTE_ID};
-use crate::engine::{EndedVoice, NoteEvent as EngineEvent, PositionMap, MAX_POLYPHONY};
+use crate::engine::{
+    mix_to_mono, Bypass, DryWet, EndedVoice, NoteEvent as EngineEvent, OnsetTrigger, PositionMap,
+    MAX_POLYPHONY,
+};
 use crate::model::factory::bank_from_state;
 use crate::params::{InputMode, ModalParams, STATE_FORMAT, STATE_FORMAT_FIELD};
 use engines::Engines;
@@ -47,12 +49,6 @@ pub type ModalResonatorFx = ModalPlugin<Effect>;
 
 /// Most note events (host events plus detected onsets) handled per block; more are dropped.
 const MAX_EVENTS: usize = 2048;
-
-/// How long the output takes to fade to the bypassed sound and back, in seconds.
-const BYPASS_FADE_S: f32 = 0.01;
-
-/// How long the bank that was playing fades out when another is loaded, in seconds.
-const BANK_CROSSFADE_S: f32 = 0.05;
 
 /// Notes whose polyphonic modulation is tracked (the engine's voices, counting those fading).
 const POLY_NOTES: usize = 2 * MAX_POLYPHONY;
@@ -112,17 +108,16 @@ pub struct ModalPlugin<K: Kind> {
     input: Vec<f32>,
     /// Dry input (the effect's input, or the instrument's exciter input).
     dry: [Vec<f32>; 2],
-    /// Onsets of the input in trigger mode.
-    onsets: OnsetDetector,
+    /// Strikes at the input's onsets in trigger mode.
+    onsets: OnsetTrigger,
     /// Where the player's controllers are.
     expression: Expression,
     /// Last key struck, if any: the pitch of onsets (else the bank's root).
     last_key: Option<u8>,
-    /// Dry/wet mix at the end of the last block; `None` after a reset (no ramp needed).
-    wet: Option<f32>,
-    /// Share of the output bypassed at the end of the last segment (0 playing, 1 bypassed);
-    /// `None` after a reset (no fade needed).
-    bypassed: Option<f32>,
+    /// The dry/wet mix, ramped from segment to segment.
+    dry_wet: DryWet,
+    /// The host's bypass, faded.
+    bypass: Bypass,
     /// The editor's size and whether it is open.
     editor_state: Arc<EguiEditorState>,
     /// Meters for the editor and its strike pad's requests.
@@ -147,11 +142,11 @@ impl<K: Kind> Default for ModalPlugin<K> {
             outgoing_out: [Vec::new(), Vec::new()],
             input: Vec::new(),
             dry: [Vec::new(), Vec::new()],
-            onsets: OnsetDetector::new(48_000.0),
+            onsets: OnsetTrigger::new(48_000.0),
             expression: Expression::default(),
             last_key: None,
-            wet: None,
-            bypassed: None,
+            dry_wet: DryWet::default(),
+            bypass: Bypass::default(),
             editor_state: editor::default_state(),
             editor_shared: Arc::new(EditorShared::new()),
             audition_key: None,
@@ -184,16 +179,14 @@ impl<K: Kind> ModalPlugin<K> {
         let threshold = util::db_to_gain(self.params.input.trigger_threshold.value());
         let retrigger_s = self.params.input.retrigger.value() * 1e-3;
         let key = self.strike_key();
-        let events = &mut self.segment_events;
-        self.onsets
-            .process(&self.input[..n], threshold, retrigger_s, |onset| {
-                if events.len() < MAX_EVENTS {
-                    let event = EngineEvent::on(onset.time, key, onset.strength);
-                    // Insert in time order; after events at the same time.
-                    let at = events.partition_point(|e| e.time() <= onset.time);
-                    events.insert(at, event);
-                }
-            });
+        self.onsets.add_strikes(
+            &self.input[..n],
+            threshold,
+            retrigger_s,
+            key,
+            &mut self.segment_events,
+            MAX_EVENTS,
+        );
     }
 
     /// Renders samples `start..end` of the block (at most the announced maximum block): the
@@ -251,19 +244,10 @@ impl<K: Kind> ModalPlugin<K> {
             outgoing.engine.set_controls(&controls);
             outgoing.engine.process(&[], drive, ol, or);
             let rate = outgoing.engine.sample_rate_hz();
-            let step = 1.0 / (BANK_CROSSFADE_S * rate);
-            for ((l, r), (a, b)) in out_l
-                .iter_mut()
-                .zip(out_r.iter_mut())
-                .zip(ol.iter().zip(or.iter()))
-            {
-                outgoing.gain = (outgoing.gain - step).max(0.0);
-                *l += outgoing.gain * a;
-                *r += outgoing.gain * b;
-            }
+            outgoing.fade.add([out_l, out_r], [ol, or], rate);
             // Nothing to tell the host: its notes were reported ended at the swap.
             let _ = outgoing.engine.take_ended_voices().count();
-            if outgoing.gain <= 0.0 || outgoing.engine.is_silent() {
+            if outgoing.fade.is_done() || outgoing.engine.is_silent() {
                 let mut done = self.engines.outgoing.take().expect("checked above").engine;
                 done.end_all_voices();
                 let _ = done.take_ended_voices().count();
@@ -274,46 +258,16 @@ impl<K: Kind> ModalPlugin<K> {
         }
 
         // Dry/wet: the effect's input, or the instrument's exciter input when it has one.
+        let dry = [&self.dry[0][..n], &self.dry[1][..n]];
         if have_input {
-            // Ramp from the last segment's mix to this one's, so automation does not zipper.
-            let to = self.params.output.dry_wet.value();
-            let from = self.wet.unwrap_or(to);
-            let step = (to - from) / n as f32;
-            for (channel, dry) in channels.iter_mut().zip(&self.dry) {
-                for (i, (out, d)) in channel[start..end].iter_mut().zip(&dry[..n]).enumerate() {
-                    let wet = from + step * (i + 1) as f32;
-                    *out = wet * *out + (1.0 - wet) * d;
-                }
-            }
-            self.wet = Some(to);
+            let wet = self.params.output.dry_wet.value();
+            self.dry_wet.mix([&mut *out_l, &mut *out_r], dry, wet);
         }
-        self.bypass(channels, start, end);
-    }
-
-    /// The host's bypass over samples `start..end`: a fade to the effect's dry input (in
-    /// `self.dry`) or to silence, over [`BYPASS_FADE_S`].
-    fn bypass(&mut self, channels: &mut [&mut [f32]], start: usize, end: usize) {
-        let to = if self.params.bypass.value() { 1.0 } else { 0.0 };
-        let from = self.bypassed.unwrap_or(to);
-        self.bypassed = Some(to);
-        if from == 0.0 && to == 0.0 {
-            return;
-        }
+        // The host's bypass: a fade to the effect's dry input, or to silence.
         let rate = f32::from_bits(self.shared.sample_rate_bits.load(Ordering::Acquire));
-        let step = 1.0 / (BYPASS_FADE_S * rate).max(1.0);
-        for (c, channel) in channels.iter_mut().take(2).enumerate() {
-            let mut share = from;
-            for (i, out) in channel[start..end].iter_mut().enumerate() {
-                share = if to > share {
-                    (share + step).min(to)
-                } else {
-                    (share - step).max(to)
-                };
-                let dry = if K::IS_EFFECT { self.dry[c][i] } else { 0.0 };
-                *out = (1.0 - share) * *out + share * dry;
-            }
-            self.bypassed = Some(share);
-        }
+        let bypassed = self.params.bypass.value();
+        let dry = K::IS_EFFECT.then_some(dry);
+        self.bypass.apply([out_l, out_r], dry, bypassed, rate);
     }
 }
 
@@ -447,7 +401,7 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         self.dry = [vec![0.0; max_block], vec![0.0; max_block]];
         self.outgoing_out = [vec![0.0; max_block], vec![0.0; max_block]];
         self.poly.clear();
-        self.onsets = OnsetDetector::new(rate);
+        self.onsets = OnsetTrigger::new(rate);
         // Build the engine here, synchronously, so offline renders start with the right bank.
         let generation = self.params.bank.generation.load(Ordering::Acquire);
         let json = self.params.bank.json_text();
@@ -490,8 +444,8 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
             engine.reset();
         }
         self.onsets.reset();
-        self.wet = None;
-        self.bypassed = None;
+        self.dry_wet.reset();
+        self.bypass.reset();
         // A reset ends every note at once, for the host as well, and forgets the last key: a
         // host's test note before a reset leaves nothing behind.
         self.engines.drop_outgoing();
@@ -635,13 +589,6 @@ pub fn migrate_state(state: &mut PluginState) {
     state
         .fields
         .insert(STATE_FORMAT_FIELD.to_string(), STATE_FORMAT.to_string());
-}
-
-/// `out = (left + right) / 2`.
-fn mix_to_mono(left: &[f32], right: &[f32], out: &mut [f32]) {
-    for ((o, l), r) in out.iter_mut().zip(left).zip(right) {
-        *o = 0.5 * (l + r);
-    }
 }
 
 impl<K: Kind> ClapPlugin for ModalPlugin<K> {
