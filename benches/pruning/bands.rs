@@ -84,3 +84,109 @@ pub fn bark_to_hz(bark: f64) -> f64 {
     }
     lo
 }
+
+/// Length of the frames the noise-to-mask ratio is measured over, in seconds.
+const NMR_FRAME_S: f64 = 0.02;
+
+/// Noise-to-mask ratios of a difference signal against the masking threshold of the signal it
+/// was taken from, per 20 ms frame and critical band.
+pub struct Nmr {
+    /// Frame-bands measured.
+    pub cells: usize,
+    /// Share of them at or below 0 dB.
+    pub share_ok: f64,
+    /// The 99th percentile, in dB.
+    pub p99_db: f64,
+    /// The worst, in dB, its critical band and the time of its frame in seconds.
+    pub worst: (f64, usize, f64),
+}
+
+/// Mean square of `x` (each channel's averaged) in each critical band, per frame of
+/// [`NMR_FRAME_S`]: Hann-windowed frames side by side, zero-padded to a power of two, the power
+/// normalised so a sine of amplitude `A` has mean square `A^2 / 2` in its band.
+fn frame_band_power(channels: [&[f32]; 2]) -> Vec<[f64; 25]> {
+    let len = (NMR_FRAME_S * RATE_HZ) as usize;
+    let n = len.next_power_of_two();
+    let window: Vec<f64> = (0..len)
+        .map(|i| 0.5 - 0.5 * (std::f64::consts::TAU * (i as f64 + 0.5) / len as f64).cos())
+        .collect();
+    let window_power: f64 = window.iter().map(|w| w * w).sum();
+    let band_of: Vec<usize> = (0..n / 2)
+        .map(|k| (hz_to_bark(k as f64 * RATE_HZ / n as f64) as usize).min(24))
+        .collect();
+    let frames = channels[0].len().min(channels[1].len()) / len;
+    let (mut re, mut im) = (vec![0.0; n], vec![0.0; n]);
+    (0..frames)
+        .map(|f| {
+            let mut bands = [0.0; 25];
+            for x in channels {
+                re.fill(0.0);
+                im.fill(0.0);
+                for (i, w) in window.iter().enumerate() {
+                    re[i] = x[f * len + i] as f64 * w;
+                }
+                fft(&mut re, &mut im);
+                // One side of the spectrum holds half of `n` times the windowed frame's sum of
+                // squares; two channels are averaged.
+                for k in 1..n / 2 {
+                    bands[band_of[k]] +=
+                        (re[k] * re[k] + im[k] * im[k]) / (n as f64 * window_power);
+                }
+            }
+            bands
+        })
+        .collect()
+}
+
+/// The noise-to-mask ratio of `diff` against `signal` (both stereo): in each 20 ms frame, each
+/// critical band's level of the signal, in dB SPL with a sine of amplitude 1 at
+/// `playback_db_spl`, is a masker at the band's centre with the two-slope curve at masking offset
+/// `offset_db` (seed 001 eq. 4); the threshold of a band is the highest of those curves and the
+/// threshold in quiet (its lowest over the band); the ratio is the difference's level in the band
+/// over that threshold.
+pub fn nmr(signal: [&[f32]; 2], diff: [&[f32]; 2], playback_db_spl: f64, offset_db: f64) -> Nmr {
+    use modal_resonator::dsp::masking::{masking_curve_db, threshold_in_quiet_db};
+    let spl = |mean_square: f64| playback_db_spl + db(2.0 * mean_square);
+    let quiet: Vec<f64> = (0..25)
+        .map(|b| {
+            let lo = bark_to_hz(b as f64).max(20.0);
+            let hi = bark_to_hz(b as f64 + 1.0).clamp(lo, 20_000.0);
+            (0..=8)
+                .map(|i| threshold_in_quiet_db(lo * (hi / lo).powf(i as f64 / 8.0)))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .collect();
+    let (s, d) = (frame_band_power(signal), frame_band_power(diff));
+    let mut ratios = Vec::with_capacity(25 * s.len());
+    let mut worst = (f64::NEG_INFINITY, 0, 0.0);
+    for (f, (s, d)) in s.iter().zip(&d).enumerate() {
+        for b in 0..25 {
+            let probe = b as f32 + 0.5;
+            let curve = (0..25)
+                .filter(|&j| s[j] > 0.0)
+                .map(|j| {
+                    masking_curve_db(j as f32 + 0.5, spl(s[j]) as f32, offset_db as f32, probe)
+                        as f64
+                })
+                .fold(f64::NEG_INFINITY, f64::max);
+            let ratio = spl(d[b]) - curve.max(quiet[b]);
+            if ratio > worst.0 {
+                worst = (ratio, b, f as f64 * NMR_FRAME_S);
+            }
+            ratios.push(ratio);
+        }
+    }
+    let cells = ratios.len();
+    let ok = ratios.iter().filter(|&&r| r <= 0.0).count();
+    ratios.sort_by(f64::total_cmp);
+    let p99 = ratios
+        .get(((cells as f64 * 0.99) as usize).min(cells.saturating_sub(1)))
+        .copied()
+        .unwrap_or(f64::NEG_INFINITY);
+    Nmr {
+        cells,
+        share_ok: ok as f64 / cells.max(1) as f64,
+        p99_db: p99,
+        worst,
+    }
+}

@@ -194,3 +194,104 @@ pub fn hail(objects: &[Object], seconds: f64, seed: u64) -> Vec<Impact> {
     }
     out
 }
+
+/// One strike of a scene: sample, key, velocity and strike position.
+#[derive(Debug, Clone, Copy)]
+pub struct Hit {
+    /// Sample it lands on.
+    pub at: usize,
+    /// MIDI key.
+    pub key: u8,
+    /// Velocity 0 to 1.
+    pub velocity: f32,
+    /// Strike position (the engine's `strike_x`).
+    pub strike_x: f32,
+}
+
+/// The hail as strikes: object `k` on key `FIRST_KEY + k`, struck at its own position.
+pub fn hail_hits(impacts: &[Impact], objects: usize) -> Vec<Hit> {
+    impacts
+        .iter()
+        .map(|&(at, object, velocity)| Hit {
+            at,
+            key: FIRST_KEY + object as u8,
+            velocity,
+            strike_x: object as f32 / (objects - 1) as f32,
+        })
+        .collect()
+}
+
+/// Modes of the dense scene's plate.
+pub const DENSE_MODES: usize = 2_200;
+
+/// Voices of the dense scene.
+pub const DENSE_VOICES: usize = 16;
+
+/// The dense scene's object: a steel sheet of [`DENSE_MODES`] modes up to about 16 kHz, struck
+/// off-centre, its root at middle C.
+pub fn dense_bank() -> Bank {
+    let sheet = Object {
+        name: "steel sheet",
+        plate: RectangularPlate {
+            length_x_m: 1.0,
+            length_y_m: 0.65,
+            thickness_m: 1.5e-3,
+        },
+        material: &materials::STEEL,
+        modes: DENSE_MODES,
+        level_db: 0.0,
+        exposure: 1.0,
+    };
+    let strike = [Position {
+        name: "off-centre".into(),
+        coords: vec![0.38, 0.42],
+    }];
+    let mut bank = Bank::new("steel sheet", strike.to_vec());
+    bank.modes = object_modes(&sheet, &strike);
+    bank
+}
+
+/// Keys the dense scene plays: a minor pentatonic over two octaves below the root, so every
+/// pitch keeps its modes under the audible limit.
+const DENSE_KEYS: [u8; 11] = [36, 39, 41, 43, 46, 48, 51, 53, 55, 58, 60];
+
+/// Chords and rolls on the sheet, seeded: a chord of four keys every 0.75 s, and between two
+/// chords a roll of six strikes ten a second on one key, softer.
+pub fn chords_and_rolls(seconds: f64, seed: u64) -> Vec<Hit> {
+    let mut s = seed;
+    let mut uniform = move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let key =
+        |u: f64| DENSE_KEYS[((u * DENSE_KEYS.len() as f64) as usize).min(DENSE_KEYS.len() - 1)];
+    let mut hits = Vec::new();
+    let mut t = 0.0;
+    while t < seconds {
+        for _ in 0..4 {
+            hits.push(Hit {
+                at: (t * RATE_HZ) as usize,
+                key: key(uniform()),
+                velocity: (0.4 + 0.6 * uniform()) as f32,
+                strike_x: 0.38,
+            });
+        }
+        let roll = key(uniform());
+        for k in 0..6 {
+            let at = t + 0.15 + 0.1 * k as f64;
+            if at < seconds {
+                hits.push(Hit {
+                    at: (at * RATE_HZ) as usize,
+                    key: roll,
+                    velocity: (0.3 + 0.4 * uniform()) as f32,
+                    strike_x: 0.38,
+                });
+            }
+        }
+        t += 0.75;
+    }
+    hits.sort_by_key(|h| h.at);
+    hits
+}
