@@ -883,3 +883,61 @@ fn a_strike_cut_before_its_ring_dies_is_fitted() {
         );
     }
 }
+
+#[test]
+fn a_strike_after_digital_silence_is_fitted_as_well_as_one_after_noise() {
+    // Three modes struck 1 s into a 16-bit file whose lead-in is exact zeros: no noise is shown
+    // anywhere, and the quietest millisecond blocks are not the lead-in's tenth of the file.
+    const MODES: [(f64, f64, f64); 3] =
+        [(440.0, 3.0, 0.4), (1234.5, 6.0, 0.2), (3333.0, 15.0, 0.1)];
+    for lead_in_s in [0.1, 1.0] {
+        let len = ((lead_in_s + 1.0) * RATE as f64) as usize;
+        let lead_in = (lead_in_s * RATE as f64) as usize;
+        let samples: Vec<f32> = (0..len)
+            .map(|n| {
+                let Some(k) = n.checked_sub(lead_in) else {
+                    return 0.0;
+                };
+                let t = k as f64 / RATE as f64;
+                let x: f64 = MODES
+                    .iter()
+                    .map(|&(f, d, a)| a * (-d * t).exp() * (std::f64::consts::TAU * f * t).sin())
+                    .sum();
+                ((x * 32767.0).round() / 32767.0) as f32
+            })
+            .collect();
+        let fit = fit_bank(
+            &[Recording::new("silent lead-in", samples, RATE)],
+            &FitOptions::default(),
+        )
+        .unwrap();
+        let strongest = fit
+            .bank
+            .modes
+            .iter()
+            .fold(0.0f64, |a, m| a.max(m.gains[0].abs()));
+        for (f, d, a) in MODES {
+            let m = modes_near(&fit.bank, f, 1.0);
+            assert!(
+                !m.is_empty(),
+                "{lead_in_s} s: {f} Hz missing: {:?}",
+                fit.bank.modes
+            );
+            let m = m[0];
+            let gain_db = db(m.gains[0] / strongest) - db(a / MODES[0].2);
+            assert!(
+                (m.freq_hz / f - 1.0).abs() <= FREQ_TOLERANCE
+                    && (m.decay_per_s / d - 1.0).abs() <= DECAY_TOLERANCE
+                    && gain_db.abs() <= GAIN_TOLERANCE_DB,
+                "{lead_in_s} s: {f} Hz, {d} /s: found {} Hz, {} /s, gain {gain_db:+.2} dB off",
+                m.freq_hz,
+                m.decay_per_s
+            );
+        }
+        let warnings = &fit.report.recordings[0].warnings;
+        assert!(
+            !warnings.iter().any(|w| w.contains("noisy")),
+            "{lead_in_s} s: {warnings:?}"
+        );
+    }
+}

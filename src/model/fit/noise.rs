@@ -40,6 +40,11 @@ const TAIL_SHARE: f64 = 0.5;
 /// rounding.
 const MAX_RANGE_DB: f64 = 80.0;
 
+/// No noise is taken lower than this many dB under the loudest bin of any frame: a recording
+/// whose quiet stretches are digital silence shows a floor of nothing, under which the level
+/// matching would follow the window's side lobes and the sound's rounding.
+const PRECISION_RANGE_DB: f64 = 120.0;
+
 /// Lowest noise power per bin relative to a full-scale sinusoid's (-150 dB): digital silence
 /// still has a finite floor.
 const MIN_RELATIVE_POWER: f64 = 1e-15;
@@ -108,10 +113,14 @@ impl NoiseSpectrum {
         } else {
             lowest
         };
+        // Digital silence shows no noise at all: the floor is then the precision of the sound
+        // itself, some way under its loudest bin.
+        let precision = loudest * 10f64.powf(-PRECISION_RANGE_DB / 10.0);
         let power = power
             .iter()
             .zip(&unshown)
             .map(|(p, u)| if *u { p.min(lowest) } else { *p })
+            .map(|p| p.max(precision))
             .collect();
         Self { power }
     }

@@ -21,6 +21,9 @@ const ONSET_BELOW_PEAK_DB: f64 = 30.0;
 /// ... and at least this many dB above the noise.
 const ONSET_ABOVE_NOISE_DB: f64 = 12.0;
 
+/// Blocks before the strike that make a lead-in to take the noise from (20 ms).
+const MIN_LEAD_IN_BLOCKS: usize = 20;
+
 /// A sample stands out of the noise when it exceeds this many noise RMS.
 const SAMPLE_ABOVE_NOISE: f64 = 5.0;
 
@@ -87,6 +90,18 @@ pub fn find_strike(x: &[f64], sample_rate_hz: f64) -> Result<Strike, String> {
         .iter()
         .position(|&e| e > threshold)
         .expect("the loudest block exceeds the threshold");
+    // A lead-in tells the noise better than a percentile over the whole file, which lands in
+    // the ring when the lead-in is under a tenth of it: the median of its blocks, clear of the
+    // strike.
+    let noise = if first > MIN_LEAD_IN_BLOCKS {
+        let mut lead_in = energies[..first - 1].to_vec();
+        let mid = lead_in.len() / 2;
+        let (_, median, _) = lead_in.select_nth_unstable_by(mid, f64::total_cmp);
+        median.max(peak * 1e-15).max(1e-18)
+    } else {
+        noise
+    };
+    let snr_db = 10.0 * (peak / noise).log10();
     let noise_rms = noise.sqrt();
     let search = first.saturating_sub(1) * block..((first + 1) * block).min(x.len());
     let onset = search
