@@ -27,7 +27,7 @@ mod voice;
 use std::sync::Arc;
 
 pub use controls::{
-    control_range, ControlSpec, Controls, Material, ANALYSIS_FRAME_RANGE_MS,
+    control_range, ControlSpec, Controls, Material, ANALYSIS_FRAME_RANGE_MS, HARDNESS_RANGE_MS,
     MASKING_OFFSET_RANGE_DB, MATERIAL_Q_RANGE, MAX_MODE_BUDGET, MAX_POLYPHONY, MAX_TARGET_LOAD_PCT,
     NUMERIC_CONTROLS, PLAYBACK_LEVEL_RANGE_DB_SPL,
 };

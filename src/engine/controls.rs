@@ -5,6 +5,7 @@ mod by_name;
 
 use super::position::PositionMap;
 use crate::dsp::ExciterKind;
+use crate::model::validate::{DAMPING_TILT, HARDNESS_MS, MATERIAL_Q};
 use crate::model::Bank;
 
 /// Most voices the engine can play at once.
@@ -211,7 +212,13 @@ macro_rules! spec {
 /// The numeric controls. `material_q`, `material` and `exciter` are handled by name in
 /// [`Controls::set_by_name`] since they are not plain numbers.
 pub const NUMERIC_CONTROLS: &[ControlSpec] = &[
-    spec!("damping_tilt", "", -2.0, 2.0, damping_tilt),
+    spec!(
+        "damping_tilt",
+        "",
+        DAMPING_TILT.min as f32,
+        DAMPING_TILT.max as f32,
+        damping_tilt
+    ),
     spec!("size_ratio", "x", 0.25, 4.0, size_ratio),
     spec!("key_tracking", "", 0.0, 1.0, key_tracking),
     spec!("fine_tune_cents", "ct", -100.0, 100.0, fine_tune_cents),
@@ -225,7 +232,13 @@ pub const NUMERIC_CONTROLS: &[ControlSpec] = &[
     spec!("strike_x", "", 0.0, 1.0, strike_x),
     spec!("strike_y", "", 0.0, 1.0, strike_y),
     spec!("position_variation", "", 0.0, 1.0, position_variation),
-    spec!("hardness_ms", "ms", 0.05, 20.0, hardness_ms),
+    spec!(
+        "hardness_ms",
+        "ms",
+        HARDNESS_RANGE_MS.0,
+        HARDNESS_RANGE_MS.1,
+        hardness_ms
+    ),
     spec!("velocity_sensitivity", "", 0.0, 1.0, velocity_sensitivity),
     spec!("velocity_to_hardness", "", 0.0, 1.0, velocity_to_hardness),
     spec!("release_damping", "", 0.0, 1.0, release_damping),
@@ -321,7 +334,10 @@ pub const MAX_MODE_BUDGET: usize = 100_000;
 pub const MAX_TARGET_LOAD_PCT: f32 = 100.0;
 
 /// Range of material Q.
-pub const MATERIAL_Q_RANGE: (f32, f32) = (1.0, 100_000.0);
+pub const MATERIAL_Q_RANGE: (f32, f32) = (MATERIAL_Q.min as f32, MATERIAL_Q.max as f32);
+
+/// Range of a strike's contact time in ms, whatever velocity makes of the hardness control.
+pub const HARDNESS_RANGE_MS: (f32, f32) = (HARDNESS_MS.min as f32, HARDNESS_MS.max as f32);
 
 impl Controls {
     /// The defaults for `bank`: struck at its first position, with the bank's own `defaults`

@@ -428,8 +428,8 @@ impl Engine {
         let velocity = pending.velocity;
         let amplitude = velocity.powf(2.0 * c.velocity_sensitivity);
         let hardness_ms = o.hardness_ms.unwrap_or(c.hardness_ms);
-        let contact_ms =
-            (hardness_ms * 4f32.powf(c.velocity_to_hardness * (1.0 - velocity))).clamp(0.05, 20.0);
+        let contact_ms = (hardness_ms * 4f32.powf(c.velocity_to_hardness * (1.0 - velocity)))
+            .clamp(HARDNESS_RANGE_MS.0, HARDNESS_RANGE_MS.1);
         let len = (contact_ms as f64 * 1e-3 * self.sample_rate_hz)
             .round()
             .max(1.0) as u32;

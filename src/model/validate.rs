@@ -98,12 +98,22 @@ pub const GAIN: NumberRange = NumberRange::closed(-1e6, 1e6, "");
 /// Position coordinates: any finite number, in a unit of the bank's choosing.
 pub const COORD: NumberRange = NumberRange::closed(f64::NEG_INFINITY, f64::INFINITY, "");
 
+/// Material Q: a bank's default, and the engine's control and host parameter.
+pub const MATERIAL_Q: NumberRange = NumberRange::closed(1.0, 100_000.0, "");
+
+/// Damping tilt: a bank's default, and the engine's control and host parameter.
+pub const DAMPING_TILT: NumberRange = NumberRange::closed(-2.0, 2.0, "");
+
+/// Mallet hardness (contact time) in ms: a bank's default, and the engine's control and host
+/// parameter; every strike's contact time is held to it.
+pub const HARDNESS_MS: NumberRange = NumberRange::closed(0.05, 20.0, " ms");
+
 /// `defaults` fields and their ranges, which are those of the matching host parameters. The
 /// typed walker lists the values of [`BankDefaults`](super::bank::BankDefaults) in this order.
 pub const DEFAULTS_RANGES: [(&str, NumberRange); 5] = [
-    ("material_q", NumberRange::closed(1.0, 100_000.0, "")),
-    ("damping_tilt", NumberRange::closed(-2.0, 2.0, "")),
-    ("hardness_ms", NumberRange::closed(0.05, 20.0, " ms")),
+    ("material_q", MATERIAL_Q),
+    ("damping_tilt", DAMPING_TILT),
+    ("hardness_ms", HARDNESS_MS),
     ("strike_position", NumberRange::closed(0.0, 1.0, "")),
     ("key_tracking_pct", NumberRange::closed(0.0, 100.0, "%")),
 ];
