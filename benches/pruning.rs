@@ -332,7 +332,21 @@ fn scene_report(
     println!();
     println!("(signal dB: each band's power relative to the strongest band)");
 
-    // The difference against the masking threshold of the unpruned signal, frame by frame.
+    // The difference against the masking threshold of the unpruned signal, frame by frame. First
+    // the measure itself: the signal 1 dB under its own masking curve is under it everywhere.
+    let c = &cases[0].1;
+    let scaled = |x: &[f32], db: f32| -> Vec<f32> {
+        let g = 10f32.powf(db / 20.0);
+        x.iter().map(|v| v * g).collect()
+    };
+    let av = 5.0;
+    let under = nmr(
+        [&off.left, &off.right],
+        [&scaled(&off.left, -av - 1.0), &scaled(&off.right, -av - 1.0)],
+        c.playback_level_db_spl as f64,
+        av as f64,
+    );
+    assert_eq!(under.share_ok, 1.0, "the noise-to-mask ratio is measured wrong");
     println!("Noise-to-mask ratio of the difference, per 20 ms frame and critical band:");
     let mut ratios = Vec::new();
     for (((name, c), (l, r)), run) in cases[1..].iter().zip(&differences).zip(&runs[1..]) {
