@@ -483,7 +483,7 @@ fn silence_is_an_error_naming_the_recording() {
     )
     .unwrap_err();
     assert!(matches!(error, FitError::Silent { .. }), "{error:?}");
-    assert!(error.to_string().contains("steady noise"), "{error}");
+    assert!(error.to_string().contains("it is steady noise"), "{error}");
 }
 
 #[test]

@@ -368,43 +368,32 @@ fn report_tracks(a: &Analysis, shapes: &[Shape], found: &[BandMode]) -> Vec<Trac
 /// starts with the strike stays, however slowly it decays: a bell's hum note, a recording cut
 /// short.
 fn drop_steady_tones(a: &mut Analysis) {
-    let (steady, modes): (Vec<Found>, Vec<Found>) = a
-        .modes
-        .iter()
-        .partition(|m| is_hum(a, m.freq_hz, m.decay_per_s, m.amplitude.norm()));
+    let sound_s = a.signal.len() as f64 / a.sample_rate_hz;
+    let heard_before = (a.before.len() as f64) >= MIN_BEFORE_S * a.sample_rate_hz;
+    let (steady, modes): (Vec<Found>, Vec<Found>) = a.modes.iter().partition(|m| {
+        let nepers = m.decay_per_s * sound_s;
+        let before =
+            heard_before && amplitude_before(a, m.freq_hz) >= BEFORE_SHARE * m.amplitude.norm();
+        let long_enough = sound_s >= MIN_STEADY_S;
+        (before && nepers < SLOW_NEPERS) || (!heard_before && long_enough && nepers < STEADY_NEPERS)
+    });
+    if steady.is_empty() {
+        return;
+    }
     for m in &steady {
-        let warning = hum_warning(a, m.freq_hz, m.decay_per_s);
-        a.warnings.push(warning);
+        a.warnings.push(format!(
+            "steady tone at {:.1} Hz left out as hum: it decays by {:.0}% over the {sound_s:.2} s \
+             of sound{}",
+            m.freq_hz,
+            100.0 * (1.0 - (-m.decay_per_s * sound_s).exp()),
+            if heard_before {
+                " and is there before the strike"
+            } else {
+                ""
+            }
+        ));
     }
     a.modes = modes;
-}
-
-/// Whether a tone at `freq_hz` decaying at `decay_per_s` from `amplitude` at the onset is hum:
-/// one that decays slowly and is already there before the strike, or, with nothing recorded
-/// before the strike, one that does not decay at all over a long enough sound.
-pub(super) fn is_hum(a: &Analysis, freq_hz: f64, decay_per_s: f64, amplitude: f64) -> bool {
-    let sound_s = a.signal.len() as f64 / a.sample_rate_hz;
-    let heard_before = (a.before.len() as f64) >= MIN_BEFORE_S * a.sample_rate_hz;
-    let nepers = decay_per_s * sound_s;
-    let before = heard_before && amplitude_before(a, freq_hz) >= BEFORE_SHARE * amplitude;
-    let long_enough = sound_s >= MIN_STEADY_S;
-    (before && nepers < SLOW_NEPERS) || (!heard_before && long_enough && nepers < STEADY_NEPERS)
-}
-
-/// The warning for a tone at `freq_hz` left out as hum.
-pub(super) fn hum_warning(a: &Analysis, freq_hz: f64, decay_per_s: f64) -> String {
-    let sound_s = a.signal.len() as f64 / a.sample_rate_hz;
-    let heard_before = (a.before.len() as f64) >= MIN_BEFORE_S * a.sample_rate_hz;
-    format!(
-        "steady tone at {freq_hz:.1} Hz left out as hum: it decays by {:.0}% over the \
-         {sound_s:.2} s of sound{}",
-        100.0 * (1.0 - (-decay_per_s * sound_s).exp()),
-        if heard_before {
-            " and is there before the strike"
-        } else {
-            ""
-        }
-    )
 }
 
 /// Amplitude of a sinusoid at `freq_hz` in the recording before the onset (Hann-windowed).

@@ -4,7 +4,9 @@
 //! Energy in 1 ms blocks: the noise level is a low percentile of the blocks (the quiet before
 //! the strike or after the ring, or the end of a recording cut short), the onset the first block
 //! clearly above both that level and the loudest block's level less a fixed range, refined to the
-//! first sample standing out of the noise.
+//! first sample standing out of the noise. Where the recording has a lead-in before the onset,
+//! the noise is then the median of the lead-in's blocks. A recording with no strike is told
+//! apart as steady noise or a held tone.
 
 /// Length of an energy block in seconds.
 const BLOCK_S: f64 = 1e-3;
@@ -117,57 +119,70 @@ pub fn find_strike(x: &[f64], sample_rate_hz: f64) -> Result<Strike, String> {
     })
 }
 
-/// Length of the frames a steady sound's spectrum is averaged over, in seconds.
-const STEADY_FRAME_S: f64 = 0.085;
+/// Length of the frames a steady sound's spectrum is averaged over, in seconds: bins of about
+/// 3 Hz, so mains hum lies well clear of the lowest bins.
+const STEADY_FRAME_S: f64 = 0.34;
 
-/// A bin is part of a tone when its averaged power stands this many dB above the median of
-/// the bins around it.
+/// A bin is part of a tone when it is the top of a peak standing this many dB above the median
+/// of the bins on each side of it.
 const TONE_ABOVE_LOCAL_DB: f64 = 15.0;
 
-/// Bins either side of a bin that make up its surroundings.
-const LOCAL_BINS: usize = 32;
+/// Bins on each side of a bin that make up its surroundings.
+const LOCAL_BINS: usize = 16;
+
+/// Bins either side of a peak's top that belong to it (the window's main lobe).
+const PEAK_HALF_WIDTH: usize = 2;
 
 /// A steady sound is a held tone when this share of its power is in tones.
 const TONAL_SHARE: f64 = 0.5;
 
 /// What a sound with no strike is, in words: a held tone (named by its strongest frequency)
-/// when most of its power stands in narrow peaks well above the spectrum around them, steady
-/// noise otherwise. The spectrum is averaged over overlapping frames, so noise varies by about
-/// a decibel from bin to bin and never makes such peaks.
+/// when most of its power stands in narrow peaks, each well above the spectrum on both sides of
+/// it, steady noise otherwise. The spectrum, of the signal less its mean, is averaged over
+/// overlapping frames, so noise varies little from bin to bin; asking for both sides keeps a
+/// steep slope of coloured noise from passing for a peak.
 fn steady_sound(x: &[f64], sample_rate_hz: f64) -> String {
-    let frame = ((STEADY_FRAME_S * sample_rate_hz) as usize).next_power_of_two();
-    if x.len() < frame {
+    let frame = ((STEADY_FRAME_S * sample_rate_hz) as usize)
+        .next_power_of_two()
+        .min(x.len().next_power_of_two() / 2);
+    if frame < 4 * LOCAL_BINS {
         return "steady noise or a held tone, too short to tell which".to_string();
     }
-    let frames = super::stft::Spectrogram::new(x, sample_rate_hz, frame, frame / 2, 1);
-    let mut mean = vec![0.0; frames.num_bins()];
-    for power in &frames.power {
-        for (m, p) in mean.iter_mut().zip(power) {
-            *m += p;
+    let mean = x.iter().sum::<f64>() / x.len() as f64;
+    let centred: Vec<f64> = x.iter().map(|v| v - mean).collect();
+    let frames = super::stft::Spectrogram::new(&centred, sample_rate_hz, frame, frame / 2, 1);
+    let mut power = vec![0.0; frames.num_bins()];
+    for p in &frames.power {
+        for (m, v) in power.iter_mut().zip(p) {
+            *m += v;
         }
     }
-    let total: f64 = mean.iter().sum();
+    let total: f64 = power.iter().sum();
     if total <= 0.0 {
         return "steady noise or a held tone".to_string();
     }
     let above = 10f64.powf(TONE_ABOVE_LOCAL_DB / 10.0);
-    let mut tonal = vec![false; mean.len()];
-    let mut around = Vec::with_capacity(2 * LOCAL_BINS + 1);
-    for k in 0..mean.len() {
-        around.clear();
-        around.extend_from_slice(
-            &mean[k.saturating_sub(LOCAL_BINS)..(k + LOCAL_BINS + 1).min(mean.len())],
-        );
-        let mid = around.len() / 2;
-        let (_, median, _) = around.select_nth_unstable_by(mid, f64::total_cmp);
-        if mean[k] > above * *median {
-            // The window's main lobe: the peak and the bins either side of it.
-            for t in &mut tonal[k.saturating_sub(2)..(k + 3).min(mean.len())] {
+    let median = |bins: &[f64]| {
+        let mut v = bins.to_vec();
+        let mid = v.len() / 2;
+        *v.select_nth_unstable_by(mid, f64::total_cmp).1
+    };
+    let n = power.len();
+    let mut tonal = vec![false; n];
+    for k in LOCAL_BINS..n.saturating_sub(LOCAL_BINS) {
+        let lobe = k - PEAK_HALF_WIDTH..=k + PEAK_HALF_WIDTH;
+        if lobe.clone().any(|j| power[j] > power[k]) {
+            continue;
+        }
+        let left = median(&power[k - LOCAL_BINS..k - PEAK_HALF_WIDTH]);
+        let right = median(&power[k + PEAK_HALF_WIDTH + 1..=k + LOCAL_BINS]);
+        if power[k] > above * left.max(right) {
+            for t in &mut tonal[lobe] {
                 *t = true;
             }
         }
     }
-    let in_tones: f64 = mean
+    let in_tones: f64 = power
         .iter()
         .zip(&tonal)
         .filter(|(_, t)| **t)
@@ -176,8 +191,8 @@ fn steady_sound(x: &[f64], sample_rate_hz: f64) -> String {
     if in_tones / total < TONAL_SHARE {
         return "it is steady noise".to_string();
     }
-    let strongest = (0..mean.len())
-        .max_by(|&a, &b| mean[a].total_cmp(&mean[b]))
+    let strongest = (0..n)
+        .max_by(|&a, &b| power[a].total_cmp(&power[b]))
         .expect("a spectrum has bins");
     format!(
         "it is a held tone (strongest near {:.0} Hz)",
@@ -292,17 +307,31 @@ mod tests {
         let noise: Vec<f64> = (0..48_000).map(|_| 0.1 * rng.bipolar() as f64).collect();
         let message = find_strike(&noise, 48_000.0).unwrap_err();
         assert!(message.contains("it is steady noise"), "{message}");
-        // Coloured noise (white noise through a one-pole low-pass) is noise too.
-        let mut state = 0.0;
-        let pink: Vec<f64> = noise
-            .iter()
-            .map(|v| {
-                state = 0.7 * state + v;
-                state
-            })
-            .collect();
-        let message = find_strike(&pink, 48_000.0).unwrap_err();
-        assert!(message.contains("it is steady noise"), "{message}");
+        // Coloured noise is noise too: white noise through a one-pole low-pass, brown noise
+        // (falling 6 dB an octave from the lowest bins up, a steep slope on either side of no
+        // peak), and noise on a DC offset.
+        let low_passed = |pole: f64| -> Vec<f64> {
+            let mut state = 0.0;
+            noise
+                .iter()
+                .map(|v| {
+                    state = pole * state + v;
+                    state
+                })
+                .collect()
+        };
+        for (name, x) in [
+            ("low-passed", low_passed(0.7)),
+            ("brown", low_passed(0.9995)),
+            ("offset", noise.iter().map(|v| v + 0.3).collect()),
+        ] {
+            // (Whether a strike is found in it is the decay test's matter.)
+            assert_eq!(steady_sound(&x, 48_000.0), "it is steady noise", "{name}");
+        }
+        let near_hz = |message: &str| -> f64 {
+            let at = message.find("strongest near ").expect(message) + "strongest near ".len();
+            message[at..].split(' ').next().unwrap().parse().unwrap()
+        };
         // A held tone with harmonics over a little noise: named, with its strongest frequency.
         let tone: Vec<f64> = (0..48_000)
             .map(|n| {
@@ -315,10 +344,8 @@ mod tests {
             .collect();
         let message = find_strike(&tone, 48_000.0).unwrap_err();
         assert!(message.contains("nor decays"), "{message}");
-        assert!(
-            message.contains("it is a held tone (strongest near 4"),
-            "{message}"
-        );
+        assert!(message.contains("it is a held tone"), "{message}");
+        assert!((near_hz(&message) - 440.0).abs() < 3.0, "{message}");
         // Hum: a mains tone under hiss.
         let hum: Vec<f64> = (0..48_000)
             .map(|n| {
@@ -327,6 +354,7 @@ mod tests {
             })
             .collect();
         let message = find_strike(&hum, 48_000.0).unwrap_err();
-        assert!(message.contains("held tone (strongest near 5"), "{message}");
+        assert!(message.contains("held tone"), "{message}");
+        assert!((near_hz(&message) - 60.0).abs() < 3.0, "{message}");
     }
 }
