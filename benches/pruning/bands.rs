@@ -102,10 +102,11 @@ pub struct Nmr {
 }
 
 /// Mean square of `x` (each channel's averaged) in each critical band, per frame of
-/// [`NMR_FRAME_S`]: Hann-windowed frames side by side, zero-padded to a power of two, the power
-/// normalised so a sine of amplitude `A` has mean square `A^2 / 2` in its band.
-fn frame_band_power(channels: [&[f32]; 2]) -> Vec<[f64; 25]> {
+/// [`NMR_FRAME_S`]: Hann-windowed frames half a frame apart, zero-padded to a power of two, the
+/// power normalised so a sine of amplitude `A` has mean square `A^2 / 2` in its band.
+pub fn frame_band_power(channels: [&[f32]; 2]) -> Vec<[f64; 25]> {
     let len = (NMR_FRAME_S * RATE_HZ) as usize;
+    let hop = len / 2;
     let n = len.next_power_of_two();
     let window: Vec<f64> = (0..len)
         .map(|i| 0.5 - 0.5 * (std::f64::consts::TAU * (i as f64 + 0.5) / len as f64).cos())
@@ -114,7 +115,7 @@ fn frame_band_power(channels: [&[f32]; 2]) -> Vec<[f64; 25]> {
     let band_of: Vec<usize> = (0..n / 2)
         .map(|k| (hz_to_bark(k as f64 * RATE_HZ / n as f64) as usize).min(24))
         .collect();
-    let frames = channels[0].len().min(channels[1].len()) / len;
+    let frames = (channels[0].len().min(channels[1].len()) + hop).saturating_sub(len) / hop;
     let (mut re, mut im) = (vec![0.0; n], vec![0.0; n]);
     (0..frames)
         .map(|f| {
@@ -123,7 +124,7 @@ fn frame_band_power(channels: [&[f32]; 2]) -> Vec<[f64; 25]> {
                 re.fill(0.0);
                 im.fill(0.0);
                 for (i, w) in window.iter().enumerate() {
-                    re[i] = x[f * len + i] as f64 * w;
+                    re[i] = x[f * hop + i] as f64 * w;
                 }
                 fft(&mut re, &mut im);
                 // One side of the spectrum holds half of `n` times the windowed frame's sum of
@@ -138,7 +139,13 @@ fn frame_band_power(channels: [&[f32]; 2]) -> Vec<[f64; 25]> {
         .collect()
 }
 
-/// The noise-to-mask ratio of `diff` against `signal` (both stereo): in each 20 ms frame, each
+/// The level in dB SPL of a mean square, with a sine of amplitude 1 at `playback_db_spl`.
+pub fn spl(mean_square: f64, playback_db_spl: f64) -> f64 {
+    playback_db_spl + db(2.0 * mean_square)
+}
+
+/// The noise-to-mask ratio of `diff` against `signal` (both stereo): in each 20 ms frame (half a
+/// frame apart), each
 /// critical band's level of the signal, in dB SPL with a sine of amplitude 1 at
 /// `playback_db_spl`, is a masker at the band's centre with the two-slope curve at masking offset
 /// `offset_db` (seed 001 eq. 4); the threshold of a band is the highest of those curves and the
@@ -146,7 +153,7 @@ fn frame_band_power(channels: [&[f32]; 2]) -> Vec<[f64; 25]> {
 /// over that threshold.
 pub fn nmr(signal: [&[f32]; 2], diff: [&[f32]; 2], playback_db_spl: f64, offset_db: f64) -> Nmr {
     use modal_resonator::dsp::masking::{masking_curve_db, threshold_in_quiet_db};
-    let spl = |mean_square: f64| playback_db_spl + db(2.0 * mean_square);
+    let spl = |mean_square: f64| spl(mean_square, playback_db_spl);
     let quiet: Vec<f64> = (0..25)
         .map(|b| {
             let lo = bark_to_hz(b as f64).max(20.0);
@@ -171,7 +178,7 @@ pub fn nmr(signal: [&[f32]; 2], diff: [&[f32]; 2], playback_db_spl: f64, offset_
                 .fold(f64::NEG_INFINITY, f64::max);
             let ratio = spl(d[b]) - curve.max(quiet[b]);
             if ratio > worst.0 {
-                worst = (ratio, b, f as f64 * NMR_FRAME_S);
+                worst = (ratio, b, f as f64 * 0.5 * NMR_FRAME_S);
             }
             ratios.push(ratio);
         }

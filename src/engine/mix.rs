@@ -22,6 +22,7 @@ pub fn mix_to_mono(left: &[f32], right: &[f32], out: &mut [f32]) {
 /// Strikes at the onsets of an audio input (the trigger input mode).
 #[derive(Debug, Clone)]
 pub struct OnsetTrigger {
+    /// Finds the onsets.
     detector: OnsetDetector,
 }
 
@@ -40,7 +41,8 @@ impl OnsetTrigger {
 
     /// Adds a strike of `key` at each onset of `input` louder than `threshold` (linear), at most
     /// one per `retrigger_s`, to `events` (timed from the start of `input`), keeping them in time
-    /// order, after events at the same time; `events` never grows past `max_events`.
+    /// order, after events at the same time; `events` never grows past `max_events` nor its
+    /// capacity, so this never allocates.
     pub fn add_strikes(
         &mut self,
         input: &[f32],
@@ -50,6 +52,7 @@ impl OnsetTrigger {
         events: &mut Vec<NoteEvent>,
         max_events: usize,
     ) {
+        let max_events = max_events.min(events.capacity());
         self.detector
             .process(input, threshold, retrigger_s, |onset| {
                 if events.len() < max_events {
@@ -63,6 +66,7 @@ impl OnsetTrigger {
 /// An engine's output fading out over [`BANK_CROSSFADE_S`] after a bank swap.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FadeOut {
+    /// The gain now, 1 down to 0.
     gain: f32,
 }
 
@@ -275,7 +279,8 @@ mod tests {
                 *v = 0.8 * (-(k as f32) / 40.0).exp() * if k % 2 == 0 { 1.0 } else { -1.0 };
             }
         }
-        let mut events = vec![NoteEvent::off(0, 60), NoteEvent::on(2000, 64, 0.5)];
+        let mut events = Vec::with_capacity(16);
+        events.extend([NoteEvent::off(0, 60), NoteEvent::on(2000, 64, 0.5)]);
         trigger.add_strikes(&input, 0.05, 0.05, 67, &mut events, 16);
         let times: Vec<u32> = events.iter().map(|e| e.time()).collect();
         assert_eq!(events.len(), 4, "{events:?}");
@@ -288,11 +293,16 @@ mod tests {
         for (strike, at) in strikes.iter().zip([1000, 25_000]) {
             assert!((at..at + 48).contains(&strike.time()), "{strike:?}");
         }
-        // Never past the limit.
+        // Never past the limit, nor the room the events have.
         let mut full = vec![NoteEvent::off(0, 60); 16];
         trigger.reset();
         trigger.add_strikes(&input, 0.05, 0.05, 67, &mut full, 16);
         assert_eq!(full.len(), 16);
+        let mut no_room = Vec::with_capacity(1);
+        no_room.push(NoteEvent::off(0, 60));
+        trigger.reset();
+        trigger.add_strikes(&input, 0.05, 0.05, 67, &mut no_room, 16);
+        assert_eq!((no_room.len(), no_room.capacity()), (1, 1));
     }
 
     #[test]
