@@ -83,6 +83,9 @@ fn with_provenance(mut bank: Bank, r: &RealRecording) -> Bank {
     bank
 }
 
+/// Slowest decay a fitted mode of these recordings may have, per second: a T60 of about 70 s.
+const MIN_FITTED_DECAY_PER_S: f64 = 0.1;
+
 #[test]
 fn real_recordings_fit_within_their_bounds() {
     let update = std::env::var_os("UPDATE_PRESETS").is_some();
@@ -117,6 +120,21 @@ fn real_recordings_fit_within_their_bounds() {
             "{}: re-synthesis {:+.2} dB from the recording's level",
             r.slug,
             report.level_db
+        );
+        // Every mode dies away: none at the floor of decays, which would keep a voice ringing
+        // for minutes.
+        let slowest = fit
+            .bank
+            .modes
+            .iter()
+            .min_by(|a, b| a.decay_per_s.total_cmp(&b.decay_per_s))
+            .unwrap();
+        assert!(
+            slowest.decay_per_s >= MIN_FITTED_DECAY_PER_S,
+            "{}: a mode at {:.1} Hz decays at {} /s",
+            r.slug,
+            slowest.freq_hz,
+            slowest.decay_per_s
         );
         if update {
             let path = preset_path(r);
