@@ -250,44 +250,7 @@ fn scene_report(
     let case_controls: Vec<Controls> = cases.iter().map(|(_, c)| c.clone()).collect();
     let runs = measure(prepared, hits, seconds, &case_controls);
     let off = &runs[0];
-    println!(
-        "{:<11} {:>13} {:>7} {:>9} {:>7} {:>7} {:>9} {:>10} {:>10} {:>9} {:>10}",
-        "case",
-        "mode-samples",
-        "fewer",
-        "wall ms",
-        "faster",
-        "pruned",
-        "analyses",
-        "cand/anal",
-        "analysis",
-        "wakes",
-        "overhead"
-    );
-    for ((name, _), r) in cases.iter().zip(&runs) {
-        let overhead_s = r.analysis_s + r.wake_s;
-        let synthesis_s = r.wall_s - overhead_s;
-        println!(
-            "{:<11} {:>13.4e} {:>6.1}x {:>9.1} {:>6.1}x {:>6.1}% {:>9} {:>10.0} {:>8.2}ms {:>7.2}ms {:>9.1}%",
-            name,
-            r.mode_samples as f64,
-            off.mode_samples as f64 / r.mode_samples as f64,
-            r.wall_s * 1e3,
-            off.wall_s / r.wall_s,
-            100.0 * r.pruned_share,
-            r.analyses,
-            r.candidates as f64 / r.analyses.max(1) as f64,
-            r.analysis_s * 1e3,
-            r.wake_s * 1e3,
-            100.0 * overhead_s / synthesis_s,
-        );
-    }
-    println!(
-        "(overhead: analyses and wakes, timed inside the engine, over the rest of the wall time; \
-         {} modes woken by strikes in the last case)",
-        runs.last().map_or(0, |r| r.woken)
-    );
-    println!();
+    print_runs(cases, &runs);
 
     // The difference signal, per critical band over the whole render.
     let reference = stereo_band_power(&off.left, &off.right);
@@ -302,37 +265,7 @@ fn scene_report(
         .iter()
         .map(|(l, r)| stereo_band_power(l, r))
         .collect();
-    let top = reference.iter().copied().fold(0.0, f64::max);
-    println!("Difference (pruned - unpruned) relative to the unpruned signal, per critical band:");
-    print!("{:>5} {:>13} {:>12}", "Bark", "Hz", "signal dB");
-    for (name, _) in &cases[1..] {
-        print!(" {:>11}", name);
-    }
-    println!();
-    for b in 0..25 {
-        if reference[b] <= 0.0 {
-            continue;
-        }
-        print!(
-            "{:>2}-{:<2} {:>6.0}-{:<6.0} {:>12.1}",
-            b,
-            b + 1,
-            bark_to_hz(b as f64),
-            bark_to_hz(b as f64 + 1.0),
-            db(reference[b] / top)
-        );
-        for d in &diffs {
-            print!(" {:>11.1}", db(d[b] / reference[b]));
-        }
-        println!();
-    }
-    let total_ref: f64 = reference.iter().sum();
-    print!("{:<5} {:>13} {:>12}", "all", "", "");
-    for d in &diffs {
-        print!(" {:>11.1}", db(d.iter().sum::<f64>() / total_ref));
-    }
-    println!();
-    println!("(signal dB: each band's power relative to the strongest band)");
+    print_bands(cases, &reference, &diffs);
 
     // The difference against the masking threshold of the unpruned signal, frame by frame.
     println!("Noise-to-mask ratio of the difference, per 20 ms frame and critical band:");
@@ -375,6 +308,197 @@ fn scene_report(
         nmr: m,
         worst_band_db,
     })
+}
+
+/// Prints what each case's render measured, against the first (pruning off).
+fn print_runs(cases: &[(String, Controls)], runs: &[Run]) {
+    let off = &runs[0];
+    println!(
+        "{:<11} {:>13} {:>7} {:>9} {:>7} {:>7} {:>9} {:>10} {:>10} {:>9} {:>10}",
+        "case",
+        "mode-samples",
+        "fewer",
+        "wall ms",
+        "faster",
+        "pruned",
+        "analyses",
+        "cand/anal",
+        "analysis",
+        "wakes",
+        "overhead"
+    );
+    for ((name, _), r) in cases.iter().zip(runs) {
+        let overhead_s = r.analysis_s + r.wake_s;
+        let synthesis_s = r.wall_s - overhead_s;
+        println!(
+            "{:<11} {:>13.4e} {:>6.1}x {:>9.1} {:>6.1}x {:>6.1}% {:>9} {:>10.0} {:>8.2}ms {:>7.2}ms {:>9.1}%",
+            name,
+            r.mode_samples as f64,
+            off.mode_samples as f64 / r.mode_samples as f64,
+            r.wall_s * 1e3,
+            off.wall_s / r.wall_s,
+            100.0 * r.pruned_share,
+            r.analyses,
+            r.candidates as f64 / r.analyses.max(1) as f64,
+            r.analysis_s * 1e3,
+            r.wake_s * 1e3,
+            100.0 * overhead_s / synthesis_s,
+        );
+    }
+    println!(
+        "(overhead: analyses and wakes, timed inside the engine, over the rest of the wall time; \
+         {} modes woken by strikes in the last case)",
+        runs.last().map_or(0, |r| r.woken)
+    );
+    println!();
+}
+
+/// Prints each case's difference from the unpruned render relative to the unpruned signal, per
+/// critical band over the whole render.
+fn print_bands(cases: &[(String, Controls)], reference: &[f64; 25], diffs: &[[f64; 25]]) {
+    let top = reference.iter().copied().fold(0.0, f64::max);
+    println!("Difference (pruned - unpruned) relative to the unpruned signal, per critical band:");
+    print!("{:>5} {:>13} {:>12}", "Bark", "Hz", "signal dB");
+    for (name, _) in &cases[1..] {
+        print!(" {:>11}", name);
+    }
+    println!();
+    for b in 0..25 {
+        if reference[b] <= 0.0 {
+            continue;
+        }
+        print!(
+            "{:>2}-{:<2} {:>6.0}-{:<6.0} {:>12.1}",
+            b,
+            b + 1,
+            bark_to_hz(b as f64),
+            bark_to_hz(b as f64 + 1.0),
+            db(reference[b] / top)
+        );
+        for d in diffs {
+            print!(" {:>11.1}", db(d[b] / reference[b]));
+        }
+        println!();
+    }
+    let total_ref: f64 = reference.iter().sum();
+    print!("{:<5} {:>13} {:>12}", "all", "", "");
+    for d in diffs {
+        print!(" {:>11.1}", db(d.iter().sum::<f64>() / total_ref));
+    }
+    println!();
+    println!("(signal dB: each band's power relative to the strongest band)");
+}
+
+/// Prints the issue's targets at a_v = 5 dB for the scenes measured.
+fn print_targets(hail: Option<&Summary>, dense: Option<&Summary>) {
+    println!("Targets at a_v = 5 dB:");
+    let transparent = |name: &str, s: &Summary| {
+        target(
+            &format!(
+                "{name}: noise-to-mask ratio at or below 0 dB in {:.2}% of frame-bands (target \
+                 99%)",
+                100.0 * s.nmr.share_ok
+            ),
+            s.nmr.share_ok >= 0.99,
+        );
+        target(
+            &format!(
+                "{name}: difference over the signal in its worst band {:+.1} dB (target below \
+                 0 dB)",
+                s.worst_band_db
+            ),
+            s.worst_band_db < 0.0,
+        );
+    };
+    if let Some(s) = hail {
+        target(
+            &format!("hail: mode-samples {:.1}x fewer (target 5x)", s.fewer),
+            s.fewer >= 5.0,
+        );
+        target(
+            &format!("hail: wall time {:.1}x less (target 4x, aim 6x)", s.faster),
+            s.faster >= 4.0,
+        );
+        target(
+            &format!(
+                "hail: pruning {:.1}% of the remaining synthesis (target at most 25%)",
+                100.0 * s.overhead
+            ),
+            s.overhead <= 0.25,
+        );
+        transparent("hail", s);
+    }
+    if let Some(s) = dense {
+        target(
+            &format!(
+                "chords and rolls: wall time {:.1}x less (target 3x)",
+                s.faster
+            ),
+            s.faster >= 3.0,
+        );
+        transparent("chords and rolls", s);
+    }
+}
+
+/// Prints what the hail scene holds: its objects, their modes and how often each is hit.
+fn print_hail_scene(
+    objects: &[scene::Object],
+    prepared: &PreparedBank,
+    impacts: &[scene::Impact],
+    seconds: f64,
+) {
+    println!(
+        "Hail on a picnic (seed 001 section 6): {} objects, {} modes, {} impacts (energies \
+         1/E over {:.0} dB) in {seconds} s",
+        objects.len(),
+        prepared.num_modes(),
+        impacts.len(),
+        db(ENERGY_RANGE),
+    );
+    for o in objects {
+        let strike = [Position {
+            name: "p".into(),
+            coords: vec![0.38, 0.42],
+        }];
+        let modes = object_modes(o, &strike);
+        let (lo, hi) = (modes[0].freq_hz, modes[modes.len() - 1].freq_hz);
+        let hits = impacts
+            .iter()
+            .filter(|i| objects[i.1].name == o.name)
+            .count();
+        println!(
+            "  {:<12} {:>5} modes, {:>6.0} to {:>6.0} Hz, {:<9} {:>3} impacts",
+            o.name, o.modes, lo, hi, o.material.display_name, hits
+        );
+    }
+}
+
+/// Renders the pruned hail `repeats()` times and prints the last render's counters.
+fn profile(prepared: &Arc<PreparedBank>, hits: &[Hit], seconds: f64, c: &Controls, av: f32) {
+    let mut run = render(prepared, hits, seconds, c, false);
+    for _ in 1..repeats() {
+        run = render(prepared, hits, seconds, c, false);
+    }
+    println!(
+        "a_v {av} dB: {:.1} ms, analyses {:.1} ms, strikes {:.1} ms, {:.1e} mode-samples, {:?}",
+        run.wall_s * 1e3,
+        run.analysis_s * 1e3,
+        run.wake_s * 1e3,
+        run.mode_samples as f64,
+        run.stats,
+    );
+}
+
+/// A scene's cases: pruning off, then at each masking offset.
+fn cases(bank: &Bank, voices: usize, hail: bool, offsets: &[f32]) -> Vec<(String, Controls)> {
+    let mut cases = vec![("off".to_string(), controls(bank, voices, hail, None))];
+    cases.extend(offsets.iter().map(|&av| {
+        (
+            format!("a_v {av} dB"),
+            controls(bank, voices, hail, Some(av)),
+        )
+    }));
+    cases
 }
 
 /// Prints one target and whether it is met.
@@ -434,57 +558,13 @@ fn main() {
         .and_then(|v| v.parse::<f32>().ok())
     {
         let c = controls(&bank, objects.len(), true, Some(av));
-        let mut run = render(&prepared, &hits, seconds, &c, false);
-        for _ in 1..repeats() {
-            run = render(&prepared, &hits, seconds, &c, false);
-        }
-        println!(
-            "a_v {av} dB: {:.1} ms, analyses {:.1} ms, strikes {:.1} ms, {:.1e} mode-samples, {:?}",
-            run.wall_s * 1e3,
-            run.analysis_s * 1e3,
-            run.wake_s * 1e3,
-            run.mode_samples as f64,
-            run.stats,
-        );
-        return;
+        return profile(&prepared, &hits, seconds, &c, av);
     }
-    let cases = |bank: &Bank, voices: usize, hail: bool| -> Vec<(String, Controls)> {
-        let mut cases = vec![("off".to_string(), controls(bank, voices, hail, None))];
-        cases.extend(offsets.iter().map(|&av| {
-            (
-                format!("a_v {av} dB"),
-                controls(bank, voices, hail, Some(av)),
-            )
-        }));
-        cases
-    };
+    let cases = |bank: &Bank, voices: usize, hail: bool| cases(bank, voices, hail, &offsets);
 
     let mut hail_summary = None;
     if wanted("hail") {
-        println!(
-            "Hail on a picnic (seed 001 section 6): {} objects, {} modes, {} impacts (energies \
-             1/E over {:.0} dB) in {seconds} s",
-            objects.len(),
-            prepared.num_modes(),
-            impacts.len(),
-            db(ENERGY_RANGE),
-        );
-        for o in &objects {
-            let strike = [Position {
-                name: "p".into(),
-                coords: vec![0.38, 0.42],
-            }];
-            let modes = object_modes(o, &strike);
-            let (lo, hi) = (modes[0].freq_hz, modes[modes.len() - 1].freq_hz);
-            let hits = impacts
-                .iter()
-                .filter(|i| objects[i.1].name == o.name)
-                .count();
-            println!(
-                "  {:<12} {:>5} modes, {:>6.0} to {:>6.0} Hz, {:<9} {:>3} impacts",
-                o.name, o.modes, lo, hi, o.material.display_name, hits
-            );
-        }
+        print_hail_scene(&objects, &prepared, &impacts, seconds);
         println!();
         hail_summary = scene_report(
             &prepared,
@@ -515,51 +595,5 @@ fn main() {
         );
     }
 
-    println!("Targets at a_v = 5 dB:");
-    let transparent = |name: &str, s: &Summary| {
-        target(
-            &format!(
-                "{name}: noise-to-mask ratio at or below 0 dB in {:.2}% of frame-bands (target \
-                 99%)",
-                100.0 * s.nmr.share_ok
-            ),
-            s.nmr.share_ok >= 0.99,
-        );
-        target(
-            &format!(
-                "{name}: difference over the signal in its worst band {:+.1} dB (target below \
-                 0 dB)",
-                s.worst_band_db
-            ),
-            s.worst_band_db < 0.0,
-        );
-    };
-    if let Some(s) = &hail_summary {
-        target(
-            &format!("hail: mode-samples {:.1}x fewer (target 5x)", s.fewer),
-            s.fewer >= 5.0,
-        );
-        target(
-            &format!("hail: wall time {:.1}x less (target 4x, aim 6x)", s.faster),
-            s.faster >= 4.0,
-        );
-        target(
-            &format!(
-                "hail: pruning {:.1}% of the remaining synthesis (target at most 25%)",
-                100.0 * s.overhead
-            ),
-            s.overhead <= 0.25,
-        );
-        transparent("hail", s);
-    }
-    if let Some(s) = &dense_summary {
-        target(
-            &format!(
-                "chords and rolls: wall time {:.1}x less (target 3x)",
-                s.faster
-            ),
-            s.faster >= 3.0,
-        );
-        transparent("chords and rolls", s);
-    }
+    print_targets(hail_summary.as_ref(), dense_summary.as_ref());
 }
