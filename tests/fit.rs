@@ -258,14 +258,7 @@ fn a_known_bank_is_recovered_from_noisy_renders() {
     let (mut worst_freq, mut worst_decay, mut worst_gain) = (0.0f64, 0.0f64, 0.0f64);
     for (i, (truth_mode, &(_, _, gains_db))) in truth.modes.iter().zip(&TRUTH).enumerate() {
         // Every true mode is within 40 dB of the strongest, so every one must be found.
-        let nearest = found
-            .iter()
-            .min_by(|a, b| {
-                (a.freq_hz - truth_mode.freq_hz)
-                    .abs()
-                    .total_cmp(&(b.freq_hz - truth_mode.freq_hz).abs())
-            })
-            .unwrap();
+        let nearest = nearest(found, truth_mode.freq_hz);
         let freq_err = (nearest.freq_hz / truth_mode.freq_hz - 1.0).abs();
         worst_freq = worst_freq.max(freq_err);
         assert!(
@@ -310,14 +303,7 @@ fn a_known_bank_is_recovered_from_noisy_renders() {
     // An impulse starts every mode in sine phase: the sign of each gain is recovered, so two
     // positions that move a mode opposite ways keep opposite signs.
     for (i, t) in truth.modes.iter().enumerate() {
-        let m = found
-            .iter()
-            .min_by(|a, b| {
-                (a.freq_hz - t.freq_hz)
-                    .abs()
-                    .total_cmp(&(b.freq_hz - t.freq_hz).abs())
-            })
-            .unwrap();
+        let m = nearest(found, t.freq_hz);
         for k in 0..2 {
             if t.gains[k] != 0.0 {
                 assert_eq!(
@@ -410,15 +396,7 @@ fn a_known_bank_is_recovered_at_any_common_sample_rate() {
             .flat_map(|m| m.gains.iter())
             .fold(0.0f64, |a, g| a.max(g.abs()));
         for (t, &(_, _, gains_db)) in truth.modes.iter().zip(&TRUTH) {
-            let m = fit
-                .modes
-                .iter()
-                .min_by(|a, b| {
-                    (a.freq_hz - t.freq_hz)
-                        .abs()
-                        .total_cmp(&(b.freq_hz - t.freq_hz).abs())
-                })
-                .unwrap();
+            let m = nearest(&fit.modes, t.freq_hz);
             assert!(
                 (m.freq_hz / t.freq_hz - 1.0).abs() <= FREQ_TOLERANCE
                     && (m.decay_per_s / t.decay_per_s - 1.0).abs() <= DECAY_TOLERANCE,
@@ -650,6 +628,18 @@ fn fit_of(modes: &[(f64, f64, [f64; 2])], seed: u64) -> Bank {
         .map(|k| noisy_recording(&bank, k, SNR_DB, seed + k as u64))
         .collect();
     fit_bank(&recordings, &FitOptions::default()).unwrap().bank
+}
+
+/// The mode of `modes` nearest `freq_hz`.
+fn nearest(modes: &[Mode], freq_hz: f64) -> &Mode {
+    modes
+        .iter()
+        .min_by(|a, b| {
+            (a.freq_hz - freq_hz)
+                .abs()
+                .total_cmp(&(b.freq_hz - freq_hz).abs())
+        })
+        .expect("at least one mode")
 }
 
 /// The modes of `bank` within `within_hz` of `freq_hz`.
