@@ -6,6 +6,7 @@
 
 pub mod coeffs;
 pub mod coeffs_batch;
+pub mod contact;
 pub mod denormal;
 pub mod exciter;
 pub mod kernels;

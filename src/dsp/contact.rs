@@ -1,0 +1,293 @@
+//! Continuous contact: the force of an object scraped or rolled along a rough surface, computed
+//! per sample from a few slowly varying inputs (contact speed and normal force).
+//!
+//! Both read a *surface profile* at the contact point as it moves (seed 000 section 4.3, after van
+//! den Doel, Kry and Pai's FoleyAutomatic): the height of the surface along the path, fractal noise
+//! whose power falls as `k^-beta` with spatial frequency `k` (the roughness sets `beta`). Read at
+//! speed `v`, a spatial frequency `k` sounds at `k v`: a faster scrape is brighter, the whole
+//! spectrum sliding up with speed. The profile is a sum of octaves of smooth value noise (a
+//! lattice of random heights per octave, eased between lattice points), each leaving the sum as
+//! its frequency at the current speed nears the Nyquist frequency, so nothing aliases.
+//!
+//! - **Scrape**: the profile seen through the contact (a low-pass whose corner is the speed over
+//!   the width of the contact: a hard, sharp scraper feels finer detail), its rate of change
+//!   driving the object: the contact point's vertical velocity, `v dh/dx`, scaled by the normal
+//!   force. Faster is louder as well as brighter.
+//! - **Roll** (seed 004 section 5.3): the same ground profile low-passed by the contact patch of a
+//!   rolling object of radius `r` (a wider patch, `sqrt(2 r d)` for an indentation `d`, smooths
+//!   more, so a large ball rolls duller), plus the object's own bumps: eight per revolution, at a
+//!   rate of speed over circumference, whose height and irregularity is the roughness: a perfect
+//!   ball has none, an irregular one a pattern that repeats once a revolution.
+//!
+//! Speed and force are smoothed over [`SMOOTHING_S`], and the force starts from zero, so a contact
+//! starts, stops and moves without a click.
+
+use std::f64::consts::TAU;
+
+/// Time constant of the speed and force smoothing, in seconds.
+pub const SMOOTHING_S: f64 = 0.005;
+
+/// Spatial frequency of the profile's lowest octave, cycles per metre (features of 5 mm).
+const LOWEST_CYCLES_PER_M: f64 = 200.0;
+
+/// Octaves of the profile: up to 200 * 2^13 = 1.6 million cycles per metre (0.6 um features).
+const OCTAVES: usize = 14;
+
+/// Lattice cells of the lowest octave before the profile repeats (and the position wraps): 2^20
+/// cells of 5 mm, 5 km of surface.
+const PERIOD_CELLS: f64 = 1_048_576.0;
+
+/// How deep a rolling object sinks into the ground, in metres: its contact patch is `sqrt(2 r d)`.
+const INDENTATION_M: f64 = 1e-5;
+
+/// Bumps per revolution of a rolling object (seed 004 section 5.3: eight impulses of different
+/// heights).
+const BUMPS: usize = 8;
+
+/// Width of a bump, as a share of the spacing between bumps.
+const BUMP_WIDTH: f64 = 0.25;
+
+/// Gain of a rolling object's ground noise: a rolling contact presses more gently than a
+/// scrape (seed 004 section 5.3 turns it down for the same reason).
+const GROUND_GAIN: f32 = 0.1;
+
+/// Force of a rolling object's tallest bump, relative.
+const BUMP_GAIN: f32 = 4.0;
+
+/// The vertical velocity is in units of the profile's RMS per lowest-octave cell crossed at this
+/// speed, metres per second (a scrape at 0.5 m/s through a 0.5 mm contact has an RMS of about 6).
+const REFERENCE_SPEED_M_PER_S: f64 = 1.0;
+
+/// How an object touches the surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ContactKind {
+    /// Sliding along it, through a contact `width_m` wide.
+    Scrape {
+        /// Width of the contact, metres.
+        width_m: f64,
+    },
+    /// Rolling on it: a round object of radius `radius_m`.
+    Roll {
+        /// Radius, metres.
+        radius_m: f64,
+    },
+}
+
+/// The contact force of one object on one surface.
+#[derive(Debug, Clone)]
+pub struct Contact {
+    /// Scrape or roll, and its size.
+    kind: ContactKind,
+    /// Roughness, 0 (smooth) to 1 (rough).
+    roughness: f32,
+    /// Amplitude of each profile octave, normalised so the whole profile has unit RMS.
+    octave_gain: [f32; OCTAVES],
+    /// Seed of the profile's lattice.
+    seed: u32,
+    /// Position along the surface, in lattice cells of the lowest octave (wraps).
+    position_cells: f64,
+    /// Each bump's height, relative.
+    bump_height: [f32; BUMPS],
+    /// Each bump's place within its slot, in revolutions.
+    bump_place: [f64; BUMPS],
+    /// Phase of the rolling object, in revolutions `[0, 1)`.
+    revolution: f64,
+    /// Smoothed speed, metres per second.
+    speed: f64,
+    /// Smoothed normal force, relative.
+    force: f32,
+    /// State of the contact low-pass.
+    low_pass: f32,
+    /// The low-pass's output one sample earlier.
+    last: f32,
+    /// Sample rate, Hz.
+    sample_rate_hz: f64,
+    /// Smoothing coefficient per sample.
+    smoothing: f64,
+}
+
+impl Contact {
+    /// A contact of `kind` at `roughness` (0 to 1), its surface drawn from `seed`, at rest.
+    pub fn new(kind: ContactKind, roughness: f32, seed: u32, sample_rate_hz: f64) -> Self {
+        let roughness = if roughness.is_finite() {
+            roughness.clamp(0.0, 1.0)
+        } else {
+            0.5
+        };
+        // beta from 2.5 (smooth: fine detail weak) down to 1 (rough: detail as strong, per
+        // octave of bandwidth, as coarse features). An octave's band holds power
+        // `k^-beta * k`, so its amplitude goes as `k^((1 - beta) / 2)`.
+        let beta = 2.5 - 1.5 * roughness as f64;
+        let mut octave_gain: [f32; OCTAVES] =
+            std::array::from_fn(|k| (2f64.powf(k as f64 * (1.0 - beta) / 2.0)) as f32);
+        let norm = octave_gain.iter().map(|g| g * g).sum::<f32>().sqrt();
+        octave_gain
+            .iter_mut()
+            .for_each(|g| *g /= norm * VALUE_NOISE_RMS);
+        let mut bump_height = [1.0f32; BUMPS];
+        let mut bump_place = [0.0f64; BUMPS];
+        for j in 0..BUMPS {
+            let (a, b) = (
+                unit(hash(seed ^ 0xB0B, j as u32, 1)),
+                unit(hash(seed ^ 0xB0B, j as u32, 2)),
+            );
+            bump_height[j] = roughness * (1.0 + 0.5 * a);
+            bump_place[j] = (j as f64 + 0.5 * roughness as f64 * b as f64) / BUMPS as f64;
+        }
+        Self {
+            kind,
+            roughness,
+            octave_gain,
+            seed,
+            position_cells: 0.0,
+            bump_height,
+            bump_place,
+            revolution: 0.0,
+            speed: 0.0,
+            force: 0.0,
+            low_pass: 0.0,
+            last: 0.0,
+            sample_rate_hz,
+            smoothing: 1.0 - (-1.0 / (SMOOTHING_S * sample_rate_hz)).exp(),
+        }
+    }
+
+    /// Roughness, 0 to 1.
+    pub fn roughness(&self) -> f32 {
+        self.roughness
+    }
+
+    /// Lets the contact go at once: force and speed back to zero, the low-pass emptied.
+    pub fn reset(&mut self) {
+        self.speed = 0.0;
+        self.force = 0.0;
+        self.low_pass = 0.0;
+        self.last = 0.0;
+    }
+
+    /// Whether the smoothed force has died away (the contact has ended).
+    pub fn is_silent(&self) -> bool {
+        self.force.abs() < 1e-6
+    }
+
+    /// Writes the contact force for the next `out.len()` samples into `out` (overwriting it), as
+    /// speed and force move towards `speed_m_per_s` and `force` (relative, 1 is a firm touch).
+    /// Non-finite or negative inputs count as zero.
+    pub fn render(&mut self, speed_m_per_s: f32, force: f32, out: &mut [f32]) {
+        let target_speed = if speed_m_per_s.is_finite() {
+            speed_m_per_s.max(0.0) as f64
+        } else {
+            0.0
+        };
+        let target_force = if force.is_finite() {
+            force.max(0.0)
+        } else {
+            0.0
+        };
+        let k = self.smoothing;
+        let dt = 1.0 / self.sample_rate_hz;
+        let width_m = match self.kind {
+            ContactKind::Scrape { width_m } => width_m.max(1e-6),
+            ContactKind::Roll { radius_m } => (2.0 * radius_m.max(1e-4) * INDENTATION_M).sqrt(),
+        };
+        let reference_cells = REFERENCE_SPEED_M_PER_S * dt * LOWEST_CYCLES_PER_M;
+        let slope_scale = (1.0 / reference_cells) as f32;
+        for y in out.iter_mut() {
+            self.speed += (target_speed - self.speed) * k;
+            self.force += (target_force - self.force) * k as f32;
+            let cells = self.speed * dt * LOWEST_CYCLES_PER_M;
+            self.position_cells = (self.position_cells + cells) % PERIOD_CELLS;
+            let height = self.profile();
+            // The contact's low-pass: corner at speed over width.
+            let corner_hz = self.speed / width_m;
+            let a = 1.0 - (-TAU * corner_hz * dt).exp() as f32;
+            self.low_pass += (height - self.low_pass) * a;
+            // Vertical velocity: the change of height per sample, in profile RMS per lattice
+            // cell of the reference speed.
+            let slope = (self.low_pass - self.last) * slope_scale;
+            self.last = self.low_pass;
+            *y = self.force
+                * match self.kind {
+                    ContactKind::Scrape { .. } => slope,
+                    ContactKind::Roll { radius_m } => {
+                        let turn = self.speed * dt / (TAU * radius_m.max(1e-4));
+                        self.revolution = (self.revolution + turn).fract();
+                        GROUND_GAIN * slope + BUMP_GAIN * self.bumps()
+                    }
+                };
+        }
+    }
+
+    /// The surface's height at the contact point: the sum of the octaves still under the
+    /// Nyquist frequency at the current speed.
+    fn profile(&self) -> f32 {
+        let nyquist_hz = 0.5 * self.sample_rate_hz;
+        let mut sum = 0.0f32;
+        let mut freq_hz = self.speed * LOWEST_CYCLES_PER_M;
+        let mut scale = 1.0;
+        for (k, &gain) in self.octave_gain.iter().enumerate() {
+            // Full weight up to half the Nyquist frequency, none from it on.
+            let weight = (2.0 - 2.0 * freq_hz / nyquist_hz).clamp(0.0, 1.0) as f32;
+            if weight == 0.0 {
+                break;
+            }
+            sum += weight * gain * value_noise(self.seed, k as u32, self.position_cells * scale);
+            freq_hz *= 2.0;
+            scale *= 2.0;
+        }
+        sum
+    }
+
+    /// The rolling object's bumps at its current phase: raised-cosine pulses, one per slot.
+    fn bumps(&self) -> f32 {
+        let slot = 1.0 / BUMPS as f64;
+        let half = 0.5 * BUMP_WIDTH * slot;
+        let mut sum = 0.0f32;
+        for j in 0..BUMPS {
+            let mut d = self.revolution - self.bump_place[j];
+            d -= d.round();
+            if d.abs() < half {
+                let shape = 0.5 + 0.5 * (std::f64::consts::PI * d / half).cos();
+                sum += self.bump_height[j] * shape as f32;
+            }
+        }
+        sum
+    }
+}
+
+/// RMS of [`value_noise`] over a long path (lattice values uniform in [-1, 1], eased): measured,
+/// to normalise the profile.
+const VALUE_NOISE_RMS: f32 = 0.48;
+
+/// Smooth value noise at `x` lattice cells: random heights in [-1, 1] at whole cells, eased
+/// between them (smoothstep), so the profile has no kinks.
+#[inline]
+fn value_noise(seed: u32, octave: u32, x: f64) -> f32 {
+    let cell = x.floor();
+    let t = (x - cell) as f32;
+    let i = cell as i64 as u32;
+    let a = unit(hash(seed, octave, i));
+    let b = unit(hash(seed, octave, i.wrapping_add(1)));
+    let s = t * t * (3.0 - 2.0 * t);
+    a + (b - a) * s
+}
+
+/// A 32-bit hash of a lattice point.
+#[inline]
+fn hash(seed: u32, octave: u32, i: u32) -> u32 {
+    let mut h = seed ^ octave.wrapping_mul(0x9E37_79B9) ^ i.wrapping_mul(0x85EB_CA6B);
+    h ^= h >> 16;
+    h = h.wrapping_mul(0x7FEB_352D);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x846C_A68B);
+    h ^ (h >> 16)
+}
+
+/// A hash mapped onto [-1, 1).
+#[inline]
+fn unit(h: u32) -> f32 {
+    (h >> 8) as f32 * (2.0 / 16_777_216.0) - 1.0
+}
+
+#[cfg(test)]
+mod tests;
