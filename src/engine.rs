@@ -27,9 +27,10 @@ mod voice;
 use std::sync::Arc;
 
 pub use controls::{
-    control_range, ControlSpec, Controls, Material, ANALYSIS_FRAME_RANGE_MS, HARDNESS_RANGE_MS,
-    MASKING_OFFSET_RANGE_DB, MATERIAL_Q_RANGE, MAX_MODE_BUDGET, MAX_POLYPHONY, MAX_TARGET_LOAD_PCT,
-    NUMERIC_CONTROLS, PLAYBACK_LEVEL_RANGE_DB_SPL,
+    control_range, ControlSpec, Controls, Material, ANALYSIS_FRAME_RANGE_MS,
+    CONTACT_SPEED_MAX_M_PER_S, HARDNESS_RANGE_MS, MASKING_OFFSET_RANGE_DB, MATERIAL_Q_RANGE,
+    MAX_MODE_BUDGET, MAX_POLYPHONY, MAX_TARGET_LOAD_PCT, NUMERIC_CONTROLS,
+    PLAYBACK_LEVEL_RANGE_DB_SPL,
 };
 pub use mix::{
     mix_to_mono, Bypass, DryWet, FadeOut, OnsetTrigger, BANK_CROSSFADE_S, BYPASS_FADE_S,
@@ -176,8 +177,12 @@ pub enum NoteEvent {
 pub enum NoteExpression {
     /// Tuning offset in semitones, smoothed like pitch bend.
     Tuning(f32),
-    /// Pressure 0 to 1: damps the note like a hand pressing on the object.
+    /// Pressure 0 to 1: the force of a contact note (scrape, roll); on a struck note, damping
+    /// like a hand pressing on the object.
     Pressure(f32),
+    /// Slide 0 to 1 (MPE's CC 74, CLAP's brightness): the speed of a contact note, from still
+    /// to the fastest contact speed.
+    Slide(f32),
 }
 
 /// A control one voice holds in place of the engine's, in the same units as [`Controls`].

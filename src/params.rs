@@ -9,7 +9,8 @@ use nice_plug::prelude::*;
 
 use crate::dsp::ExciterKind;
 use crate::engine::{
-    control_range, Controls, Material, VoiceModulation, MATERIAL_Q_RANGE, MAX_POLYPHONY,
+    control_range, Controls, Material, VoiceModulation, CONTACT_SPEED_MAX_M_PER_S,
+    MATERIAL_Q_RANGE, MAX_POLYPHONY,
 };
 use crate::model::factory::{factory_bank, DEFAULT_FACTORY_BANK};
 
@@ -75,6 +76,12 @@ pub enum ExciterChoice {
     #[id = "noise"]
     #[name = "Noise burst"]
     Noise,
+    /// Scraping along a rough surface while the note is held.
+    #[id = "scrape"]
+    Scrape,
+    /// Rolling on a rough surface while the note is held.
+    #[id = "roll"]
+    Roll,
 }
 
 /// What the audio input does.
@@ -103,6 +110,14 @@ pub enum ExpressionTarget {
     /// Damps the object, as a hand pressing on it.
     #[id = "damping"]
     Damping,
+    /// Sets the speed of a scrape or roll, from still to the fastest.
+    #[id = "speed"]
+    #[name = "Contact speed"]
+    Speed,
+    /// Sets the force of a scrape or roll.
+    #[id = "force"]
+    #[name = "Contact force"]
+    Force,
 }
 
 /// The bank in use, saved in the plugin state as its JSON text, so a project reopens with the
@@ -233,6 +248,18 @@ pub struct StrikeParams {
     /// How much velocity shortens the contact (harder strikes are brighter).
     #[id = "velhrd"]
     pub velocity_to_hardness: FloatParam,
+    /// Roughness of a scraped or rolled surface and of a rolling object.
+    #[id = "rough"]
+    pub roughness: FloatParam,
+    /// Radius of a rolling object, in mm.
+    #[id = "radius"]
+    pub rolling_radius: FloatParam,
+    /// Speed of a scrape or roll, in m/s.
+    #[id = "cspeed"]
+    pub contact_speed: FloatParam,
+    /// Force of a scrape or roll at full velocity.
+    #[id = "cforce"]
+    pub contact_force: FloatParam,
 }
 
 /// What the object is made of: how its modes decay. Group "Material".
@@ -396,6 +423,30 @@ impl ModalParams {
                 .with_poly_modulation_id(poly_id::HARDNESS),
                 velocity_sensitivity: percent("Velocity sensitivity", 0.8),
                 velocity_to_hardness: percent("Velocity to hardness", 0.5),
+                roughness: percent("Roughness", d.roughness),
+                rolling_radius: FloatParam::new(
+                    "Rolling radius",
+                    d.rolling_radius_mm,
+                    FloatRange::Skewed {
+                        min: control_range("rolling_radius_mm").0,
+                        max: control_range("rolling_radius_mm").1,
+                        factor: FloatRange::skew_factor(-1.5),
+                    },
+                )
+                .with_unit(" mm")
+                .with_step_size(0.1),
+                contact_speed: FloatParam::new(
+                    "Contact speed",
+                    d.contact_speed_m_per_s,
+                    FloatRange::Skewed {
+                        min: control_range("contact_speed_m_per_s").0,
+                        max: control_range("contact_speed_m_per_s").1,
+                        factor: FloatRange::skew_factor(-1.0),
+                    },
+                )
+                .with_unit(" m/s")
+                .with_step_size(0.01),
+                contact_force: percent("Contact force", d.contact_force),
             },
             material: MaterialParams {
                 material: EnumParam::new("Material", MaterialChoice::Authored),
@@ -541,6 +592,8 @@ impl ModalParams {
         };
         let mut strike_x = self.strike.strike_x.value();
         let mut extra_damping = 0.0;
+        let mut contact_speed_m_per_s = self.strike.contact_speed.value();
+        let mut contact_force = self.strike.contact_force.value();
         for (target, amount) in [
             (self.voices.mod_wheel_target.value(), mod_wheel),
             (self.voices.pressure_target.value(), pressure),
@@ -549,6 +602,10 @@ impl ModalParams {
                 ExpressionTarget::None => {}
                 ExpressionTarget::Position => strike_x += amount * (1.0 - strike_x),
                 ExpressionTarget::Damping => extra_damping += amount,
+                ExpressionTarget::Speed => {
+                    contact_speed_m_per_s = amount * CONTACT_SPEED_MAX_M_PER_S
+                }
+                ExpressionTarget::Force => contact_force = amount,
             }
         }
         Controls {
@@ -565,7 +622,13 @@ impl ModalParams {
                 ExciterChoice::Mallet => ExciterKind::Mallet,
                 ExciterChoice::Impulse => ExciterKind::Impulse,
                 ExciterChoice::Noise => ExciterKind::Noise,
+                ExciterChoice::Scrape => ExciterKind::Scrape,
+                ExciterChoice::Roll => ExciterKind::Roll,
             },
+            roughness: self.strike.roughness.value(),
+            rolling_radius_mm: self.strike.rolling_radius.value(),
+            contact_speed_m_per_s,
+            contact_force,
             hardness_ms: self.strike.hardness.value(),
             velocity_sensitivity: self.strike.velocity_sensitivity.value(),
             velocity_to_hardness: self.strike.velocity_to_hardness.value(),
@@ -594,6 +657,10 @@ mod tests {
                 (&p.object.size, "size_ratio"),
                 (&p.object.fine_tune, "fine_tune_cents"),
                 (&p.strike.hardness, "hardness_ms"),
+                (&p.strike.roughness, "roughness"),
+                (&p.strike.rolling_radius, "rolling_radius_mm"),
+                (&p.strike.contact_speed, "contact_speed_m_per_s"),
+                (&p.strike.contact_force, "contact_force"),
                 (&p.material.damping_tilt, "damping_tilt"),
                 (&p.voices.truncation, "truncation_db"),
                 (&p.output.output_gain, "output_gain_db"),

@@ -84,7 +84,7 @@ fn process_never_allocates() {
             } else {
                 Some(10.0 + 50.0 * b as f32)
             };
-            c.exciter = ExciterKind::ALL[b % 3];
+            c.exciter = ExciterKind::ALL[b % ExciterKind::ALL.len()];
             c
         })
         .collect();
@@ -108,7 +108,11 @@ fn process_never_allocates() {
                         6 => NoteEvent::ChannelExpression {
                             time,
                             channel: (i % 3) as u8,
-                            expression: NoteExpression::Tuning((b % 7) as f32 - 3.0),
+                            expression: match b % 3 {
+                                0 => NoteExpression::Tuning((b % 7) as f32 - 3.0),
+                                1 => NoteExpression::Pressure((b % 5) as f32 / 4.0),
+                                _ => NoteExpression::Slide((b % 9) as f32 / 8.0),
+                            },
                         },
                         7 => NoteEvent::Choke { time, note },
                         _ => NoteEvent::On {
@@ -171,7 +175,7 @@ fn pruning_and_the_budget_never_allocate() {
             c.analysis_frame_ms = [2.0, 20.0, 46.0][b / 30 % 3];
             c.mode_budget = [0, 40, 300][b / 25 % 3];
             c.target_load_pct = [0.0, 1.0, 20.0][b / 35 % 3];
-            c.exciter = ExciterKind::ALL[b / 10 % 3];
+            c.exciter = ExciterKind::ALL[b / 10 % ExciterKind::ALL.len()];
             c.output_gain_db = -((b % 5) as f32) * 3.0;
             c.size_ratio = 1.0 + (b % 9) as f32 * 0.01;
             c

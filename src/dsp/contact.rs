@@ -157,6 +157,19 @@ impl Contact {
         self.roughness
     }
 
+    /// Scrape or roll, and its size.
+    pub fn kind(&self) -> ContactKind {
+        self.kind
+    }
+
+    /// Changes the size of the contact (scrape width, rolling radius) from the next sample; the
+    /// kind stays what it was.
+    pub fn set_kind(&mut self, kind: ContactKind) {
+        if std::mem::discriminant(&kind) == std::mem::discriminant(&self.kind) {
+            self.kind = kind;
+        }
+    }
+
     /// Lets the contact go at once: force and speed back to zero, the low-pass emptied.
     pub fn reset(&mut self) {
         self.speed = 0.0;
@@ -170,7 +183,7 @@ impl Contact {
         self.force.abs() < 1e-6
     }
 
-    /// Writes the contact force for the next `out.len()` samples into `out` (overwriting it), as
+    /// Adds the contact force for the next `out.len()` samples into `out`, as
     /// speed and force move towards `speed_m_per_s` and `force` (relative, 1 is a firm touch).
     /// Non-finite or negative inputs count as zero.
     pub fn render(&mut self, speed_m_per_s: f32, force: f32, out: &mut [f32]) {
@@ -206,7 +219,7 @@ impl Contact {
             // cell of the reference speed.
             let slope = (self.low_pass - self.last) * slope_scale;
             self.last = self.low_pass;
-            *y = self.force
+            *y += self.force
                 * match self.kind {
                     ContactKind::Scrape { .. } => slope,
                     ContactKind::Roll { radius_m } => {

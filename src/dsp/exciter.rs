@@ -6,10 +6,16 @@
 
 use std::f32::consts::TAU;
 
+use super::contact::{Contact, ContactKind};
 use super::rng::Rng;
 
+/// Level of a contact's force against a strike's: a scrape at 0.5 m/s and full force, held,
+/// drives a bank to about the level of the first half second of a mallet strike at full
+/// velocity (measured on a bank of 200 modes from 110 Hz in `tests/contact.rs`).
+const CONTACT_GAIN: f32 = 3.7e-4;
+
 /// How many overlapping strikes one voice keeps; a further strike replaces the oldest.
-const MAX_PULSES: usize = 4;
+pub const MAX_PULSES: usize = 4;
 
 /// The shape of a strike.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -20,16 +26,22 @@ pub enum ExciterKind {
     /// seed 000 eq. 4.5): short T is a hard, bright mallet, long T a soft, dull one.
     #[default]
     Mallet,
-    /// White noise under a linearly falling envelope over the contact time: a scrape or brush.
+    /// White noise under a linearly falling envelope over the contact time: a brush.
     Noise,
+    /// Scraping for as long as the note is held ([`super::contact`]).
+    Scrape,
+    /// Rolling for as long as the note is held ([`super::contact`]).
+    Roll,
 }
 
 impl ExciterKind {
     /// Every kind, for parameter lists.
-    pub const ALL: [ExciterKind; 3] = [
+    pub const ALL: [ExciterKind; 5] = [
         ExciterKind::Impulse,
         ExciterKind::Mallet,
         ExciterKind::Noise,
+        ExciterKind::Scrape,
+        ExciterKind::Roll,
     ];
 
     /// Lowercase name.
@@ -38,6 +50,8 @@ impl ExciterKind {
             ExciterKind::Impulse => "impulse",
             ExciterKind::Mallet => "mallet",
             ExciterKind::Noise => "noise",
+            ExciterKind::Scrape => "scrape",
+            ExciterKind::Roll => "roll",
         }
     }
 
@@ -46,19 +60,47 @@ impl ExciterKind {
         Self::ALL.into_iter().find(|k| k.name() == name)
     }
 
+    /// Whether the exciter is a contact held with the note (scrape, roll) rather than a strike.
+    pub fn is_contact(self) -> bool {
+        matches!(self, ExciterKind::Scrape | ExciterKind::Roll)
+    }
+
+    /// The strike's shape when it is known in full in advance (impulse, mallet); `None` for
+    /// noise and contact, whose samples are not. This alone decides what pruning may take
+    /// analytically.
+    pub fn pulse_shape(self) -> Option<PulseShape> {
+        match self {
+            ExciterKind::Impulse => Some(PulseShape::Impulse),
+            ExciterKind::Mallet => Some(PulseShape::Mallet),
+            ExciterKind::Noise | ExciterKind::Scrape | ExciterKind::Roll => None,
+        }
+    }
+
     /// Bound on a mode's amplitude after a strike of unit amplitude, relative to its gain: 1 for
     /// unit-area pulses; for noise of `len` samples and unit energy, `sqrt(len)` (Cauchy-Schwarz).
     pub fn peak_bound(self, len_samples: u32) -> f32 {
         match self {
             ExciterKind::Impulse | ExciterKind::Mallet => 1.0,
             ExciterKind::Noise => (len_samples.max(1) as f32).sqrt(),
+            // A contact's force is at most its normal force times a few (the profile's peaks).
+            ExciterKind::Scrape | ExciterKind::Roll => 1.0,
         }
     }
 }
 
+/// The shape of a strike known in full when it comes: what a dormant mode can take without
+/// being computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PulseShape {
+    /// A single sample.
+    Impulse,
+    /// A raised cosine `(A / L) (1 - cos(2 pi (j + 1/2) / L))` over `L` samples (the mallet).
+    Mallet,
+}
+
 /// One strike in progress.
 #[derive(Debug, Clone, Copy)]
-struct Pulse {
+struct StrikeUnderWay {
     /// Shape of the pulse.
     kind: ExciterKind,
     /// Scale of the pulse: its area (impulse, mallet) or the square root of its energy (noise).
@@ -71,13 +113,21 @@ struct Pulse {
     noise_scale: f32,
 }
 
-/// The strikes under way on one voice.
+/// The strikes under way on one voice, and its contact.
 #[derive(Debug, Clone)]
 pub struct Exciter {
     /// Active pulses; the first `count` are in use.
-    pulses: [Pulse; MAX_PULSES],
+    pulses: [StrikeUnderWay; MAX_PULSES],
     /// Number of active pulses.
     count: usize,
+    /// The contact held with the note (scrape, roll), while `in_contact`.
+    contact: Contact,
+    /// Whether a contact is under way: held, or dying away after its release.
+    in_contact: bool,
+    /// Where the contact's speed is going, m/s.
+    contact_speed: f32,
+    /// Where the contact's normal force is going, 0 to 1.
+    contact_force: f32,
     /// Noise source, reseeded on reset so output repeats.
     rng: Rng,
     /// Seed restored by `reset`.
@@ -87,7 +137,7 @@ pub struct Exciter {
 impl Exciter {
     /// An idle exciter whose noise starts from `seed`.
     pub fn new(seed: u32) -> Self {
-        let idle = Pulse {
+        let idle = StrikeUnderWay {
             kind: ExciterKind::Impulse,
             amplitude: 0.0,
             len: 0,
@@ -97,6 +147,10 @@ impl Exciter {
         Self {
             pulses: [idle; MAX_PULSES],
             count: 0,
+            contact: Contact::new(ContactKind::Scrape { width_m: 1e-3 }, 0.5, seed, 48_000.0),
+            in_contact: false,
+            contact_speed: 0.0,
+            contact_force: 0.0,
             rng: Rng::new(seed),
             seed,
         }
@@ -105,12 +159,53 @@ impl Exciter {
     /// Drops every pulse and restarts the noise sequence.
     pub fn reset(&mut self) {
         self.count = 0;
+        self.in_contact = false;
+        self.contact.reset();
         self.rng = Rng::new(self.seed);
     }
 
-    /// Whether no strike is under way.
+    /// Whether no strike or contact is under way.
     pub fn is_idle(&self) -> bool {
-        self.count == 0
+        self.count == 0 && !self.in_contact
+    }
+
+    /// Whether a contact is under way (held, or dying away after its release).
+    pub fn in_contact(&self) -> bool {
+        self.in_contact
+    }
+
+    /// Starts a contact of `kind` at `roughness` moving towards `speed_m_per_s` and `force`
+    /// from the next sample (from no force, so without a click); a contact of the same kind
+    /// under way carries on towards them.
+    pub fn start_contact(
+        &mut self,
+        kind: ContactKind,
+        roughness: f32,
+        sample_rate_hz: f64,
+        speed_m_per_s: f32,
+        force: f32,
+    ) {
+        let same = self.in_contact
+            && std::mem::discriminant(&self.contact.kind()) == std::mem::discriminant(&kind)
+            && self.contact.roughness() == roughness;
+        if !same {
+            self.contact = Contact::new(kind, roughness, self.seed, sample_rate_hz);
+        } else {
+            self.contact.set_kind(kind);
+        }
+        self.in_contact = true;
+        self.set_contact(speed_m_per_s, force);
+    }
+
+    /// Moves the contact under way towards `speed_m_per_s` and `force`.
+    pub fn set_contact(&mut self, speed_m_per_s: f32, force: f32) {
+        self.contact_speed = speed_m_per_s;
+        self.contact_force = force;
+    }
+
+    /// Lets the contact go: its force falls to nothing, and it ends.
+    pub fn release_contact(&mut self) {
+        self.contact_force = 0.0;
     }
 
     /// How many strikes are under way.
@@ -140,7 +235,7 @@ impl Exciter {
         let l = len as f32;
         let env_energy = (l + 1.0) * (2.0 * l + 1.0) / (6.0 * l);
         let noise_scale = (3.0 / env_energy.max(1e-9)).sqrt();
-        let pulse = Pulse {
+        let pulse = StrikeUnderWay {
             kind,
             amplitude,
             len,
@@ -159,15 +254,24 @@ impl Exciter {
     /// Writes the excitation for the next `out.len()` samples into `out` (overwriting it).
     /// Returns whether any pulse contributed.
     pub fn render(&mut self, out: &mut [f32]) -> bool {
-        if self.count == 0 {
+        if self.count == 0 && !self.in_contact {
             return false;
         }
         out.fill(0.0);
+        if self.in_contact {
+            self.contact
+                .render(self.contact_speed, CONTACT_GAIN * self.contact_force, out);
+            if self.contact_force == 0.0 && self.contact.is_silent() {
+                self.in_contact = false;
+            }
+        }
         let mut i = 0;
         while i < self.count {
             let p = &mut self.pulses[i];
             let n = ((p.len - p.pos) as usize).min(out.len());
             match p.kind {
+                // Contacts are not strikes: they never reach here.
+                ExciterKind::Scrape | ExciterKind::Roll => {}
                 ExciterKind::Impulse => {
                     if n > 0 {
                         out[0] += p.amplitude;

@@ -82,6 +82,10 @@ fn groups(p: &ModalParams) -> Vec<(&'static str, Vec<Control<'_>>)> {
                 Float(&p.strike.hardness),
                 Float(&p.strike.velocity_sensitivity),
                 Float(&p.strike.velocity_to_hardness),
+                Float(&p.strike.roughness),
+                Float(&p.strike.rolling_radius),
+                Float(&p.strike.contact_speed),
+                Float(&p.strike.contact_force),
             ],
         ),
         (

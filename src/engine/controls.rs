@@ -108,6 +108,14 @@ pub struct Controls {
     pub velocity_sensitivity: f32,
     /// How much softer notes lengthen the contact time (up to 4x at velocity 0).
     pub velocity_to_hardness: f32,
+    /// Roughness of a scraped or rolled surface and of a rolling object, 0 (smooth) to 1.
+    pub roughness: f32,
+    /// Radius of a rolling object, in mm.
+    pub rolling_radius_mm: f32,
+    /// Contact speed of a scrape or roll, in m/s.
+    pub contact_speed_m_per_s: f32,
+    /// Normal force of a scrape or roll at full velocity, 0 to 1.
+    pub contact_force: f32,
     /// Damping applied on note-off: 0 lets the object ring on, 1 damps it within about 50 ms.
     pub release_damping: f32,
     /// Extra damping of every mode, 0 (none) to 1 (decays 20 times faster), for expression
@@ -157,6 +165,10 @@ impl Default for Controls {
             hardness_ms: 0.25,
             velocity_sensitivity: 0.8,
             velocity_to_hardness: 0.5,
+            roughness: 0.5,
+            rolling_radius_mm: 20.0,
+            contact_speed_m_per_s: 0.5,
+            contact_force: 0.7,
             release_damping: 0.0,
             extra_damping: 0.0,
             truncation_db: -96.0,
@@ -241,6 +253,16 @@ pub const NUMERIC_CONTROLS: &[ControlSpec] = &[
     ),
     spec!("velocity_sensitivity", "", 0.0, 1.0, velocity_sensitivity),
     spec!("velocity_to_hardness", "", 0.0, 1.0, velocity_to_hardness),
+    spec!("roughness", "", 0.0, 1.0, roughness),
+    spec!("rolling_radius_mm", "mm", 1.0, 200.0, rolling_radius_mm),
+    spec!(
+        "contact_speed_m_per_s",
+        "m/s",
+        0.0,
+        CONTACT_SPEED_MAX_M_PER_S,
+        contact_speed_m_per_s
+    ),
+    spec!("contact_force", "", 0.0, 1.0, contact_force),
     spec!("release_damping", "", 0.0, 1.0, release_damping),
     spec!("extra_damping", "", 0.0, 1.0, extra_damping),
     spec!("truncation_db", "dBFS", -140.0, -60.0, truncation_db),
@@ -315,6 +337,9 @@ pub fn control_range(name: &str) -> (f32, f32) {
         .unwrap_or_else(|| panic!("no numeric control named {name}"));
     (spec.min, spec.max)
 }
+
+/// Fastest scrape or roll, in m/s: a quick stroke of the hand.
+pub const CONTACT_SPEED_MAX_M_PER_S: f32 = 3.0;
 
 /// Range of the masking offset `a_v` in dB (seed 001 found 5 dB transparent, 20 dB the
 /// laboratory figure for tone-on-tone masking).

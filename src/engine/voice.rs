@@ -98,8 +98,17 @@ pub struct Voice {
     pub fade_gain: f32,
     /// Per-note tuning offset in semitones (note expression).
     pub tuning_semitones: f32,
-    /// Per-note pressure 0 to 1, damping the object like a hand on it (note expression).
+    /// Per-note pressure 0 to 1 (note expression): the contact's force on a contact note, else
+    /// damping the object like a hand on it.
     pub pressure: f32,
+    /// Whether the note plays a contact (scrape, roll) rather than a strike.
+    pub contact: bool,
+    /// A contact note's force from its velocity, until pressure takes over (0 to 1).
+    pub contact_velocity: f32,
+    /// Whether pressure has come for the note since it started: it then sets a contact's force.
+    pub pressed: bool,
+    /// Per-note slide 0 to 1 (note expression, MPE's CC 74): a contact's speed, if it came.
+    pub slide: Option<f32>,
 }
 
 impl Voice {
@@ -120,6 +129,10 @@ impl Voice {
             fade_gain: 1.0,
             tuning_semitones: 0.0,
             pressure: 0.0,
+            contact: false,
+            contact_velocity: 0.0,
+            pressed: false,
+            slide: None,
         }
     }
 
@@ -137,6 +150,9 @@ impl Voice {
         self.fade_gain = 1.0;
         self.tuning_semitones = 0.0;
         self.pressure = 0.0;
+        self.contact = false;
+        self.pressed = false;
+        self.slide = None;
         self.id = None;
         self.overrides = VoiceOverrides::default();
         self.pending_strike = None;
@@ -149,7 +165,11 @@ impl Voice {
                 self.tuning_semitones =
                     semitones.clamp(-MAX_EXPRESSION_SEMITONES, MAX_EXPRESSION_SEMITONES)
             }
-            NoteExpression::Pressure(p) if p.is_finite() => self.pressure = p.clamp(0.0, 1.0),
+            NoteExpression::Pressure(p) if p.is_finite() => {
+                self.pressure = p.clamp(0.0, 1.0);
+                self.pressed = true;
+            }
+            NoteExpression::Slide(s) if s.is_finite() => self.slide = Some(s.clamp(0.0, 1.0)),
             _ => {}
         }
     }
@@ -234,7 +254,10 @@ impl Voice {
         }
         self.modes.set_gains_with(|m| gains[m]);
         self.retune(bank, decay, sample_rate_hz, tuning);
-        self.exciter.strike(kind, amplitude, len_samples);
+        // A contact is started by the engine, which knows its controls.
+        if !kind.is_contact() {
+            self.exciter.strike(kind, amplitude, len_samples);
+        }
     }
 
     /// Starts mode `m`, struck with `gain`, at `pitch`: dormant with `start_dormant`, else

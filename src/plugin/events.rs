@@ -8,7 +8,10 @@ use nice_plug::prelude::*;
 use super::{Kind, ModalPlugin, MAX_EVENTS};
 use crate::editor::Audition;
 use crate::engine::{Note, NoteEvent as EngineEvent, NoteExpression};
-use crate::params::ExpressionTarget;
+use crate::params::{ExciterChoice, ExpressionTarget};
+
+/// MIDI CC 74 (sound controller 5, "brightness"): MPE's slide, the third dimension of a note.
+const SLIDE_CC: u8 = 74;
 
 /// MIDI channels.
 pub const CHANNELS: usize = 16;
@@ -79,8 +82,14 @@ impl<K: Kind> ModalPlugin<K> {
         self.changes.clear();
         let mpe = self.params.voices.mpe.value();
         let mpe_range = self.params.voices.mpe_bend_range.value();
+        // Per-note pressure damps a struck note when routed to damping, and is the force of a
+        // contact note (scrape, roll) whatever the routing.
+        let contact = matches!(
+            self.params.strike.exciter.value(),
+            ExciterChoice::Scrape | ExciterChoice::Roll
+        );
         let pressure_damps =
-            self.params.voices.pressure_target.value() == ExpressionTarget::Damping;
+            contact || self.params.voices.pressure_target.value() == ExpressionTarget::Damping;
         let is_member = |channel: u8| mpe && channel != MPE_MANAGER_CHANNEL;
         self.read_auditions();
         while let Some(event) = context.next_event() {
@@ -176,6 +185,22 @@ impl<K: Kind> ModalPlugin<K> {
                         });
                     }
                 }
+                // Brightness (CLAP's note expression) is a note's slide: a contact's speed.
+                NoteEvent::PolyBrightness {
+                    timing,
+                    voice_id,
+                    channel,
+                    key,
+                    brightness,
+                } => {
+                    if let Some(note) = note_of(voice_id, channel, key) {
+                        self.push(EngineEvent::Expression {
+                            time: timing,
+                            note,
+                            expression: NoteExpression::Slide(brightness),
+                        });
+                    }
+                }
                 NoteEvent::PolyModulation {
                     timing,
                     voice_id,
@@ -253,6 +278,17 @@ impl<K: Kind> ModalPlugin<K> {
                         self.change(timing, ControlChange::Pressure(pressure));
                     }
                 }
+                // An MPE member channel's slide is its note's.
+                NoteEvent::MidiCC {
+                    timing,
+                    cc: SLIDE_CC,
+                    channel,
+                    value,
+                } if is_member(channel) => self.push(EngineEvent::ChannelExpression {
+                    time: timing,
+                    channel,
+                    expression: NoteExpression::Slide(value.clamp(0.0, 1.0)),
+                }),
                 NoteEvent::MidiCC {
                     timing, cc, value, ..
                 } => match cc {

@@ -21,8 +21,8 @@ use super::ResonatorBank;
 use crate::dsp::masking::power_to_db;
 use crate::dsp::prefetch::{self, prefetch};
 
-/// Most pulses kept track of at once (as many as one exciter overlaps).
-pub(super) const MAX_PULSES: usize = 4;
+/// Most pulses kept track of at once: as many as one exciter overlaps.
+pub(super) use crate::dsp::exciter::MAX_PULSES;
 
 /// Below this distance from 1 a geometric ratio is summed term by term rather than in closed
 /// form (the closed form divides by it).
@@ -39,15 +39,7 @@ const BOUND_NEPERS: f64 = 0.35;
 /// about -92 dB).
 pub(super) const MAX_ABSORB_NEPERS: f64 = 6.0;
 
-/// The kinds of pulse a dormant mode can take without being computed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PulseShape {
-    /// A single sample.
-    Impulse,
-    /// A raised cosine `(A / L) (1 - cos(2 pi (j + 1/2) / L))` over `L` samples (the exciter's
-    /// mallet).
-    Mallet,
-}
+pub use crate::dsp::exciter::PulseShape;
 
 /// A pulse: its shape, its area and its length in samples.
 #[derive(Debug, Clone, Copy, PartialEq)]

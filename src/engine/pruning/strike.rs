@@ -27,7 +27,7 @@ use super::candidates::{energy_db, Reading, DORMANT, DRIVEN};
 use super::{samples_to_cross, OffReason, NO_TAG};
 use crate::dsp::masking::{power_to_db, DB_PER_NEPER};
 use crate::dsp::prefetch::{self, prefetch};
-use crate::dsp::resonator_bank::{Pulse, PulseShape};
+use crate::dsp::resonator_bank::Pulse;
 use crate::dsp::ExciterKind;
 use crate::engine::voice::start_threshold;
 use crate::engine::voice::VoiceState;
@@ -54,9 +54,9 @@ impl Engine {
             return;
         }
         let start = self.pruner.profiling.then(Instant::now);
-        match kind {
-            ExciterKind::Impulse | ExciterKind::Mallet => modes.wake_fading(),
-            ExciterKind::Noise => modes.wake_all(),
+        match kind.pulse_shape() {
+            Some(_) => modes.wake_fading(),
+            None => modes.wake_all(),
         }
         if let Some(start) = start {
             self.pruner.stats.strike_ns += start.elapsed().as_nanos() as u64;
@@ -73,10 +73,8 @@ impl Engine {
         amplitude: f32,
         len: u32,
     ) {
-        let shape = match kind {
-            ExciterKind::Impulse => PulseShape::Impulse,
-            ExciterKind::Mallet => PulseShape::Mallet,
-            ExciterKind::Noise => return,
+        let Some(shape) = kind.pulse_shape() else {
+            return;
         };
         let start = self.pruner.profiling.then(Instant::now);
         let pulse = Pulse {

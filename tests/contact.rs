@@ -1,0 +1,191 @@
+//! Contact notes in the engine: a scrape or roll sounds for as long as its note is held, rings on
+//! after it, starts and stops without a click, follows speed and force from the controls and the
+//! note's expression, and a roll repeats once a revolution in the output.
+
+mod common;
+
+use common::*;
+use modal_resonator::dsp::ExciterKind;
+use modal_resonator::engine::{Engine, Note, NoteEvent, NoteExpression};
+use modal_resonator::model::Bank;
+
+const RATE: f32 = 48_000.0;
+const KEY: u8 = 60;
+
+fn note() -> Note {
+    Note {
+        key: KEY,
+        channel: 0,
+        id: None,
+    }
+}
+
+fn contact_engine(bank: &Bank, kind: ExciterKind, speed: f32) -> Engine {
+    let mut e = engine(bank, RATE);
+    let mut c = e.controls().clone();
+    c.exciter = kind;
+    c.contact_speed_m_per_s = speed;
+    c.key_tracking = 0.0;
+    e.set_controls(&c);
+    e
+}
+
+/// Mono sum of a render with `events`.
+fn play(e: &mut Engine, events: &[NoteEvent], seconds: f64) -> Vec<f32> {
+    let (l, r) = render(e, events, seconds, 256);
+    l.iter().zip(&r).map(|(a, b)| a + b).collect()
+}
+
+fn rms(x: &[f32]) -> f64 {
+    (x.iter().map(|&v| (v as f64).powi(2)).sum::<f64>() / x.len().max(1) as f64).sqrt()
+}
+
+fn span(x: &[f32], from_s: f64, to_s: f64) -> &[f32] {
+    &x[(from_s * RATE as f64) as usize..(to_s * RATE as f64) as usize]
+}
+
+fn release_at(seconds: f64) -> NoteEvent {
+    NoteEvent::Off {
+        time: (seconds * RATE as f64) as u32,
+        note: note(),
+    }
+}
+
+#[test]
+fn a_held_scrape_sounds_until_released_then_rings_on() {
+    let bank = dense_bank(200, 110.0);
+    let mut e = contact_engine(&bank, ExciterKind::Scrape, 0.5);
+    let x = play(&mut e, &[on(0, KEY, 1.0), release_at(1.0)], 2.5);
+    let (early, late) = (rms(span(&x, 0.4, 0.7)), rms(span(&x, 0.7, 1.0)));
+    assert!(early > 1e-3, "silent while held: {early}");
+    let held_db = 20.0 * (late / early).log10();
+    assert!(
+        held_db.abs() < 3.0,
+        "not sustained: {held_db:.1} dB from 0.4-0.7 s to 0.7-1.0 s"
+    );
+    // After the release the object rings on, and dies away.
+    let after = rms(span(&x, 1.1, 1.3));
+    assert!(
+        after > 0.05 * late && after < late,
+        "after release {after} against {late}"
+    );
+    assert!(rms(span(&x, 2.3, 2.5)) < 0.5 * after);
+    // With a strike at the same velocity, a contact is about as loud as a struck note.
+    let mut s = contact_engine(&bank, ExciterKind::Mallet, 0.5);
+    let struck = rms(span(&play(&mut s, &[on(0, KEY, 1.0)], 0.5), 0.0, 0.5));
+    let db = 20.0 * (late / struck).log10();
+    println!("scrape at 0.5 m/s: {db:.1} dB against a mallet strike over its first 0.5 s");
+    assert!(db.abs() < 6.0, "scrape {db:.1} dB against a strike");
+}
+
+#[test]
+fn contacts_start_and_stop_without_a_click() {
+    let bank = dense_bank(200, 110.0);
+    for kind in [ExciterKind::Scrape, ExciterKind::Roll] {
+        let mut e = contact_engine(&bank, kind, 0.8);
+        let x = play(&mut e, &[on(0, KEY, 1.0), release_at(1.0)], 1.5);
+        let steady = max_step(span(&x, 0.3, 1.0));
+        let start = max_step(span(&x, 0.0, 0.3));
+        let stop = max_step(span(&x, 1.0, 1.5));
+        assert!(
+            start <= steady && stop <= steady,
+            "{kind:?}: steps {start} at the start, {stop} at the stop, {steady} held"
+        );
+    }
+}
+
+fn centroid_hz(x: &[f32]) -> f64 {
+    let n = x.len().next_power_of_two() / 2;
+    let spectrum: Vec<f64> = (1..n / 2)
+        .map(|k| magnitude_at(&x[..n], RATE as f64, k as f64 * RATE as f64 / n as f64).powi(2))
+        .collect();
+    let hz = RATE as f64 / n as f64;
+    let total: f64 = spectrum.iter().sum();
+    spectrum
+        .iter()
+        .enumerate()
+        .map(|(k, e)| (k + 1) as f64 * hz * e)
+        .sum::<f64>()
+        / total
+}
+
+#[test]
+fn speed_and_force_follow_the_controls_and_the_notes_expression() {
+    let bank = dense_bank(300, 110.0);
+    let held = |e: &mut Engine, extra: &[NoteEvent]| {
+        let mut events = vec![on(0, KEY, 1.0)];
+        events.extend_from_slice(extra);
+        let x = play(e, &events, 0.6);
+        span(&x, 0.3, 0.6).to_vec()
+    };
+    let slow = held(&mut contact_engine(&bank, ExciterKind::Scrape, 0.1), &[]);
+    let fast = held(&mut contact_engine(&bank, ExciterKind::Scrape, 1.5), &[]);
+    let (c_slow, c_fast) = (centroid_hz(&slow[..8192]), centroid_hz(&fast[..8192]));
+    assert!(
+        c_fast > 1.5 * c_slow,
+        "centroid {c_fast:.0} Hz fast, {c_slow:.0} Hz slow"
+    );
+    // The note's slide sets the speed instead.
+    let slide = |s: f32| NoteEvent::Expression {
+        time: 10,
+        note: note(),
+        expression: NoteExpression::Slide(s),
+    };
+    let slid = held(
+        &mut contact_engine(&bank, ExciterKind::Scrape, 0.1),
+        &[slide(0.5)],
+    );
+    assert!(centroid_hz(&slid[..8192]) > 1.5 * c_slow);
+    // Pressure sets the force, in proportion.
+    let pressure = |p: f32| NoteEvent::Expression {
+        time: 10,
+        note: note(),
+        expression: NoteExpression::Pressure(p),
+    };
+    let full = rms(&held(
+        &mut contact_engine(&bank, ExciterKind::Scrape, 0.5),
+        &[pressure(1.0)],
+    ));
+    let light = rms(&held(
+        &mut contact_engine(&bank, ExciterKind::Scrape, 0.5),
+        &[pressure(0.25)],
+    ));
+    let db = 20.0 * (light / full).log10();
+    assert!(
+        (db - 20.0 * 0.25f64.log10()).abs() < 1.0,
+        "pressure 0.25: {db:.1} dB"
+    );
+}
+
+#[test]
+fn a_roll_repeats_once_a_revolution_in_the_output() {
+    // Modes that die within a few tens of ms, so each bump is heard apart.
+    let modes: Vec<(f64, f64, f64)> = (0..40)
+        .map(|k| (300.0 + 97.0 * k as f64, 60.0, 1.0 / (1.0 + k as f64)))
+        .collect();
+    let bank = simple_bank(&modes);
+    for (radius_mm, speed) in [(20.0f32, 0.5f32), (50.0, 1.2)] {
+        let mut e = contact_engine(&bank, ExciterKind::Roll, speed);
+        let mut c = e.controls().clone();
+        c.rolling_radius_mm = radius_mm;
+        c.roughness = 0.8;
+        e.set_controls(&c);
+        let x = play(&mut e, &[on(0, KEY, 1.0)], 4.5);
+        let x = span(&x, 0.5, 4.5);
+        // Envelope: mean square over 1 ms.
+        let env: Vec<f64> = x.chunks(48).map(|b| rms(b).powi(2)).collect();
+        let mean = env.iter().sum::<f64>() / env.len() as f64;
+        let d: Vec<f64> = env.iter().map(|v| v - mean).collect();
+        let zero: f64 = d.iter().map(|v| v * v).sum();
+        let ac = |lag: usize| d.iter().zip(&d[lag..]).map(|(a, b)| a * b).sum::<f64>() / zero;
+        let period_ms = std::f64::consts::TAU * radius_mm as f64 * 1e-3 / speed as f64 * 1e3;
+        let (lo, hi) = ((0.6 * period_ms) as usize, (1.4 * period_ms) as usize);
+        let peak = (lo..hi).max_by(|&a, &b| ac(a).total_cmp(&ac(b))).unwrap();
+        let (l, m, r) = (ac(peak - 1), ac(peak), ac(peak + 1));
+        let found = peak as f64 + 0.5 * (l - r) / (l - 2.0 * m + r);
+        assert!(
+            (found / period_ms - 1.0).abs() < 0.02,
+            "radius {radius_mm} mm at {speed} m/s: {found:.1} ms against {period_ms:.1} ms"
+        );
+    }
+}
