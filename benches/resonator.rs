@@ -3,7 +3,8 @@
 //! Run with `cargo bench`. Every case renders a fixed amount of audio and prints a figure:
 //! mode-samples per second for each kernel at several bank sizes (all kernels in the same run, so
 //! ratios are side by side), then the real-time factor of 16 voices x 256 modes at 48 kHz in
-//! 64-sample blocks through the whole engine.
+//! 64-sample blocks through the whole engine, and of one voice held in contact (scrape, roll)
+//! against one struck, on the same bank.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -14,7 +15,7 @@ use std::time::Instant;
 
 use modal_resonator::dsp::coeffs::ModeCoeffs;
 use modal_resonator::dsp::denormal::FlushDenormals;
-use modal_resonator::dsp::{Kernel, ResonatorBank, COLUMNS};
+use modal_resonator::dsp::{ExciterKind, Kernel, ResonatorBank, COLUMNS};
 use modal_resonator::engine::{Engine, NoteEvent, PreparedBank};
 
 const RATE_HZ: f64 = 48_000.0;
@@ -97,6 +98,31 @@ fn engine_realtime_factor(kernel: Kernel, sweep: bool, seconds: f64) -> (f64, us
     (seconds / best, live)
 }
 
+/// Real-time factor of one voice of the bench bank played by `kind` (a strike rings; a contact is
+/// held throughout), with nothing truncated.
+fn voice_realtime_factor(kind: ExciterKind, seconds: f64) -> f64 {
+    let prepared = Arc::new(PreparedBank::new(&common::bench_bank()));
+    let mut best = f64::INFINITY;
+    for _ in 0..REPEATS {
+        let mut engine = Engine::new(prepared.clone());
+        engine.prepare(RATE_HZ as f32, BLOCK);
+        let mut controls = engine.controls().clone();
+        controls.truncation_db = -140.0;
+        controls.exciter = kind;
+        engine.set_controls(&controls);
+        let (mut l, mut r) = (vec![0.0f32; BLOCK], vec![0.0f32; BLOCK]);
+        engine.process(&[NoteEvent::on(0, 36, 1.0)], None, &mut l, &mut r);
+        let blocks = (seconds * RATE_HZ) as usize / BLOCK;
+        let start = Instant::now();
+        for _ in 0..blocks {
+            engine.process(&[], None, &mut l, &mut r);
+            black_box((&mut l, &mut r));
+        }
+        best = best.min(start.elapsed().as_secs_f64());
+    }
+    seconds / best
+}
+
 fn main() {
     // `cargo test --benches` runs this with --bench absent; keep that quick.
     let quick = !std::env::args().any(|a| a == "--bench");
@@ -159,6 +185,22 @@ fn main() {
             k.name(),
             rt,
             rt_sweep
+        );
+    }
+    println!();
+    println!(
+        "One voice of the same bank ({} modes), struck and ringing against held in contact:",
+        common::bench_bank().modes.len()
+    );
+    let struck = voice_realtime_factor(ExciterKind::Mallet, engine_seconds);
+    for kind in [ExciterKind::Scrape, ExciterKind::Roll] {
+        let held = voice_realtime_factor(kind, engine_seconds);
+        println!(
+            "  {:<8} real-time factor {:>8.1}x, struck {:>8.1}x: a contact voice costs {:.2}x a struck one",
+            kind.name(),
+            held,
+            struck,
+            struck / held
         );
     }
 }

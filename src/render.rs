@@ -17,7 +17,10 @@ pub use notes::{parse_notes, Note};
 pub use wav::{to_int_sample, wav_bytes, write_wav, BitDepth, WavFile};
 
 use crate::dsp::ExciterKind;
-use crate::engine::{Controls, Engine, NoteEvent, PositionMap, PreparedBank};
+use crate::engine::{
+    Controls, Engine, NoteEvent, NoteExpression, PositionMap, PreparedBank,
+    CONTACT_SPEED_MAX_M_PER_S,
+};
 use crate::model::Bank;
 use crate::units::{db_to_gain, gain_to_db};
 
@@ -206,6 +209,7 @@ fn schedule(notes: &[Note], rate: f64) -> Vec<TimedEvent> {
             rank: 1,
             event: NoteEvent::on(0, note.key, note.velocity),
         });
+        contact_curves(note, rate, &mut events);
         if let Some(release_s) = note.release_s() {
             let off = to_sample(release_s).max(on);
             events.push(TimedEvent {
@@ -218,6 +222,51 @@ fn schedule(notes: &[Note], rate: f64) -> Vec<TimedEvent> {
     // Stable, so simultaneous strikes keep the order they were given in.
     events.sort_by_key(|e| (e.sample, e.rank));
     events
+}
+
+/// Seconds between the points of a note's contact curves: finer than the engine's 5 ms
+/// smoothing, so a ramp is followed without steps.
+const CURVE_STEP_S: f64 = 0.002;
+
+/// A note's contact curves (speed, force) as the note's slide and pressure, from its strike to
+/// its release (or the strike alone, for a note held until it dies away).
+fn contact_curves(note: &Note, rate: f64, events: &mut Vec<TimedEvent>) {
+    if note.speed_m_per_s.is_none() && note.force.is_none() {
+        return;
+    }
+    let duration = note.duration_s.unwrap_or(0.0);
+    let steps = (duration / CURVE_STEP_S).ceil() as usize;
+    let who = crate::engine::Note {
+        key: note.key,
+        channel: 0,
+        id: None,
+    };
+    for i in 0..=steps {
+        let u = if steps == 0 {
+            0.0
+        } else {
+            i as f64 / steps as f64
+        };
+        let sample = ((note.time_s + u * duration) * rate).round() as u64;
+        let at = |(a, b): (f64, f64)| (a + (b - a) * u) as f32;
+        let mut push = |expression| {
+            events.push(TimedEvent {
+                sample,
+                rank: 1,
+                event: NoteEvent::Expression {
+                    time: 0,
+                    note: who,
+                    expression,
+                },
+            })
+        };
+        if let Some(speed) = note.speed_m_per_s {
+            push(NoteExpression::Slide(at(speed) / CONTACT_SPEED_MAX_M_PER_S));
+        }
+        if let Some(force) = note.force {
+            push(NoteExpression::Pressure(at(force)));
+        }
+    }
 }
 
 /// Seconds until the longest-ringing mode of `bank` falls below the truncation threshold after a
@@ -296,12 +345,7 @@ pub fn resynthesize(bank: &Bank, position: usize, sample_rate_hz: u32, len: usiz
         max_seconds: len as f64 / sample_rate_hz as f64,
         ..RenderSettings::default()
     };
-    let note = Note {
-        key: RESYNTHESIS_KEY,
-        velocity: 1.0,
-        time_s: 0.0,
-        duration_s: None,
-    };
+    let note = Note::new(RESYNTHESIS_KEY, 1.0, 0.0, None);
     let rendered = render(&prepared, &[note], &settings, |_| {});
     // With width 0 both channels carry the sum of the modes.
     let scale = 1.0 / prepared.normalization;

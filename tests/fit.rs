@@ -139,12 +139,7 @@ fn clean_render_at(bank: &Bank, k: usize, rate: u32) -> Vec<f64> {
         max_seconds: SECONDS,
         ..Default::default()
     };
-    let note = Note {
-        key: 60,
-        velocity: 1.0,
-        time_s: 0.0,
-        duration_s: None,
-    };
+    let note = Note::new(60, 1.0, 0.0, None);
     let out = render(&prepared, &[note], &settings, |_| {});
     let mut x: Vec<f64> = out
         .left

@@ -91,36 +91,16 @@ fn notes_parse_with_optional_durations_and_whitespace() {
     assert_eq!(
         notes,
         vec![
-            Note {
-                key: 60,
-                velocity: 0.8,
-                time_s: 0.0,
-                duration_s: None
-            },
-            Note {
-                key: 64,
-                velocity: 0.5,
-                time_s: 0.25,
-                duration_s: None
-            },
+            Note::new(60, 0.8, 0.0, None),
+            Note::new(64, 0.5, 0.25, None),
         ]
     );
     let notes = parse_notes("  60 : 0.8 @ 0.0 + 0.5 ,\t127:1@3\n").unwrap();
     assert_eq!(
         notes,
         vec![
-            Note {
-                key: 60,
-                velocity: 0.8,
-                time_s: 0.0,
-                duration_s: Some(0.5)
-            },
-            Note {
-                key: 127,
-                velocity: 1.0,
-                time_s: 3.0,
-                duration_s: None
-            },
+            Note::new(60, 0.8, 0.0, Some(0.5)),
+            Note::new(127, 1.0, 3.0, None),
         ]
     );
     assert_eq!(notes[0].release_s(), Some(0.5));

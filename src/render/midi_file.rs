@@ -170,6 +170,8 @@ fn notes_of(smf: &Smf) -> Vec<Note> {
                     velocity: velocity as f32 / MAX_VELOCITY,
                     time_s,
                     duration_s: None,
+                    speed_m_per_s: None,
+                    force: None,
                 });
             }
             Event::Off { channel, key } => {
