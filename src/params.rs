@@ -236,6 +236,9 @@ pub struct StrikeParams {
     /// Random variation of the strike position from strike to strike.
     #[id = "posvar"]
     pub position_variation: FloatParam,
+    /// Random variation of each strike's pitch, decay and mode gains.
+    #[id = "strvar"]
+    pub strike_variation: FloatParam,
     /// What strikes the object: mallet, impulse or noise burst.
     #[id = "exc"]
     pub exciter: EnumParam<ExciterChoice>,
@@ -408,6 +411,7 @@ impl ModalParams {
                 strike_y: percent("Strike position Y", d.strike_y)
                     .with_poly_modulation_id(poly_id::STRIKE_Y),
                 position_variation: percent("Position variation", 0.0),
+                strike_variation: percent("Strike variation", 0.0),
                 exciter: EnumParam::new("Exciter", ExciterChoice::Mallet),
                 hardness: FloatParam::new(
                     "Hardness",
@@ -618,6 +622,7 @@ impl ModalParams {
             strike_x,
             strike_y: self.strike.strike_y.value(),
             position_variation: self.strike.position_variation.value(),
+            strike_variation: self.strike.strike_variation.value(),
             exciter: match self.strike.exciter.value() {
                 ExciterChoice::Mallet => ExciterKind::Mallet,
                 ExciterChoice::Impulse => ExciterKind::Impulse,

@@ -78,6 +78,7 @@ fn groups(p: &ModalParams) -> Vec<(&'static str, Vec<Control<'_>>)> {
                 Float(&p.strike.strike_x),
                 Float(&p.strike.strike_y),
                 Float(&p.strike.position_variation),
+                Float(&p.strike.strike_variation),
                 Choice(&p.strike.exciter),
                 Float(&p.strike.hardness),
                 Float(&p.strike.velocity_sensitivity),

@@ -100,6 +100,10 @@ pub struct Controls {
     pub strike_y: f32,
     /// Random change of the strike position per strike, as a fraction of the range.
     pub position_variation: f32,
+    /// Random change of each strike's sound (seed 004 section 5.4), 0 (every strike alike) to 1:
+    /// up to [`VARIATION_CENTS`] of pitch, [`VARIATION_DECAY`] of decay and [`VARIATION_GAIN_DB`]
+    /// of each mode's gain. Drawn from the engine's seeded generator, so a render repeats.
+    pub strike_variation: f32,
     /// Shape of a strike.
     pub exciter: ExciterKind,
     /// Mallet contact time at full velocity in ms: short is hard and bright.
@@ -161,6 +165,7 @@ impl Default for Controls {
             strike_x: 0.0,
             strike_y: 0.0,
             position_variation: 0.0,
+            strike_variation: 0.0,
             exciter: ExciterKind::Mallet,
             hardness_ms: 0.25,
             velocity_sensitivity: 0.8,
@@ -244,6 +249,7 @@ pub const NUMERIC_CONTROLS: &[ControlSpec] = &[
     spec!("strike_x", "", 0.0, 1.0, strike_x),
     spec!("strike_y", "", 0.0, 1.0, strike_y),
     spec!("position_variation", "", 0.0, 1.0, position_variation),
+    spec!("strike_variation", "", 0.0, 1.0, strike_variation),
     spec!(
         "hardness_ms",
         "ms",
@@ -337,6 +343,15 @@ pub fn control_range(name: &str) -> (f32, f32) {
         .unwrap_or_else(|| panic!("no numeric control named {name}"));
     (spec.min, spec.max)
 }
+
+/// Most a strike's pitch moves at full strike variation, in cents (either way).
+pub const VARIATION_CENTS: f32 = 5.0;
+
+/// Most a strike's decay changes at full strike variation, as a share (either way).
+pub const VARIATION_DECAY: f32 = 0.05;
+
+/// Most a mode's gain changes at full strike variation, in dB (either way).
+pub const VARIATION_GAIN_DB: f32 = 1.5;
 
 /// Fastest scrape or roll, in m/s: a quick stroke of the hand.
 pub const CONTACT_SPEED_MAX_M_PER_S: f32 = 3.0;

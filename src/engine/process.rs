@@ -2,6 +2,7 @@
 
 use super::*;
 use crate::dsp::contact::ContactKind;
+use crate::dsp::masking::DB_PER_NEPER;
 use crate::dsp::ExciterKind;
 
 impl Engine {
@@ -414,6 +415,15 @@ impl Engine {
         let c = &self.controls;
         let v = &mut self.voices[i];
         let o = v.overrides;
+        let variation = c.strike_variation;
+        (v.variation_semitones, v.variation_log_damping) = if variation > 0.0 {
+            (
+                variation * VARIATION_CENTS / 100.0 * self.rng.bipolar(),
+                (1.0 + variation * VARIATION_DECAY * self.rng.bipolar()).ln(),
+            )
+        } else {
+            (0.0, 0.0)
+        };
         if pending.fresh {
             v.log_pitch =
                 target_log_pitch(c, self.bank.root_key, v.key, &o) + expression_log_pitch(v);
@@ -432,6 +442,13 @@ impl Engine {
         }
         let weights = self.bank.positions.weights(x, y);
         self.bank.gains_at(&weights, &mut self.strike_gains);
+        if variation > 0.0 {
+            // Each mode's gain within the variation's dB either way.
+            let spread = variation * VARIATION_GAIN_DB / DB_PER_NEPER;
+            for g in &mut self.strike_gains {
+                *g *= (spread * self.rng.bipolar()).exp();
+            }
+        }
         // Force: velocity^(2 s); contact: up to 4x longer for soft notes.
         let velocity = pending.velocity;
         let amplitude = velocity.powf(2.0 * c.velocity_sensitivity);
@@ -686,7 +703,7 @@ fn contact_targets(c: &Controls, v: &Voice) -> (f32, f32) {
 }
 
 fn expression_log_pitch(v: &Voice) -> f64 {
-    v.tuning_semitones as f64 * std::f64::consts::LN_2 / 12.0
+    (v.tuning_semitones + v.variation_semitones) as f64 * std::f64::consts::LN_2 / 12.0
 }
 
 /// The tuning voice `v` should have, given the engine's decay table version and the release decay.
@@ -700,10 +717,11 @@ fn tuning_of(v: &Voice, damping_version: u64, release_decay_per_s: f64) -> Tunin
             0.0
         },
         // On a contact note pressure is the contact's force, not a hand damping the object.
-        log_damping: if v.contact {
-            0.0
-        } else {
-            v.pressure as f64 * MAX_EXTRA_DAMPING.ln()
-        },
+        log_damping: v.variation_log_damping as f64
+            + if v.contact {
+                0.0
+            } else {
+                v.pressure as f64 * MAX_EXTRA_DAMPING.ln()
+            },
     }
 }

@@ -98,6 +98,10 @@ pub struct Voice {
     pub fade_gain: f32,
     /// Per-note tuning offset in semitones (note expression).
     pub tuning_semitones: f32,
+    /// The last strike's random change of pitch, in semitones (strike variation).
+    pub variation_semitones: f32,
+    /// The last strike's random change of decay, as a natural log of its multiplier.
+    pub variation_log_damping: f32,
     /// Per-note pressure 0 to 1 (note expression): the contact's force on a contact note, else
     /// damping the object like a hand on it.
     pub pressure: f32,
@@ -128,6 +132,8 @@ impl Voice {
             applied: None,
             fade_gain: 1.0,
             tuning_semitones: 0.0,
+            variation_semitones: 0.0,
+            variation_log_damping: 0.0,
             pressure: 0.0,
             contact: false,
             contact_velocity: 0.0,
@@ -149,6 +155,8 @@ impl Voice {
         self.applied = None;
         self.fade_gain = 1.0;
         self.tuning_semitones = 0.0;
+        self.variation_semitones = 0.0;
+        self.variation_log_damping = 0.0;
         self.pressure = 0.0;
         self.contact = false;
         self.pressed = false;
