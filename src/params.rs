@@ -84,6 +84,19 @@ pub enum ExciterChoice {
     Roll,
 }
 
+impl ExciterChoice {
+    /// The choice that plays `kind`.
+    pub fn of(kind: ExciterKind) -> Self {
+        match kind {
+            ExciterKind::Impulse => ExciterChoice::Impulse,
+            ExciterKind::Mallet => ExciterChoice::Mallet,
+            ExciterKind::Noise => ExciterChoice::Noise,
+            ExciterKind::Scrape => ExciterChoice::Scrape,
+            ExciterKind::Roll => ExciterChoice::Roll,
+        }
+    }
+}
+
 /// What the audio input does.
 #[derive(Enum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum InputMode {
@@ -412,7 +425,7 @@ impl ModalParams {
                     .with_poly_modulation_id(poly_id::STRIKE_Y),
                 position_variation: percent("Position variation", 0.0),
                 strike_variation: percent("Strike variation", 0.0),
-                exciter: EnumParam::new("Exciter", ExciterChoice::Mallet),
+                exciter: EnumParam::new("Exciter", ExciterChoice::of(d.exciter)),
                 hardness: FloatParam::new(
                     "Hardness",
                     d.hardness_ms,

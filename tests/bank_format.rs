@@ -40,7 +40,12 @@ const GOOD_BANK: &str = r#"{
     "damping_tilt": 0.5,
     "hardness_ms": 0.4,
     "strike_position": 0.0,
-    "key_tracking_pct": 100
+    "key_tracking_pct": 100,
+    "exciter": "mallet",
+    "roughness": 0.5,
+    "rolling_radius_mm": 20,
+    "contact_speed_m_per_s": 0.5,
+    "contact_force": 0.7
   }
 }
 "#;
@@ -928,6 +933,41 @@ fn validate_bank_applies_the_same_rules_in_memory() {
             "key_tracking_pct",
             BankDefaults {
                 key_tracking_pct: Some(-1.0),
+                ..Default::default()
+            },
+        ),
+        (
+            "exciter",
+            BankDefaults {
+                exciter: Some("bow".into()),
+                ..Default::default()
+            },
+        ),
+        (
+            "roughness",
+            BankDefaults {
+                roughness: Some(1.5),
+                ..Default::default()
+            },
+        ),
+        (
+            "rolling_radius_mm",
+            BankDefaults {
+                rolling_radius_mm: Some(0.0),
+                ..Default::default()
+            },
+        ),
+        (
+            "contact_speed_m_per_s",
+            BankDefaults {
+                contact_speed_m_per_s: Some(4.0),
+                ..Default::default()
+            },
+        ),
+        (
+            "contact_force",
+            BankDefaults {
+                contact_force: Some(-0.1),
                 ..Default::default()
             },
         ),

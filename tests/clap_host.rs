@@ -143,10 +143,10 @@ fn a_bank_loaded_while_playing_takes_over_without_a_gap() {
 
 /// The parameter ids of the plugins, as in `src/params.rs`.
 const PARAM_IDS: &[&str] = &[
-    "mat", "q", "tilt", "size", "keytrk", "fine", "bendrg", "posx", "posy", "posvar", "exc",
-    "hard", "velsns", "velhrd", "reldmp", "trunc", "poly", "width", "gain", "inmode", "ingain",
-    "trigth", "retrig", "mix", "modwhl", "press", "mpe", "mpebnd", "prune", "maskav", "spl",
-    "prfrm", "budget", "load", "bypass",
+    "mat", "q", "tilt", "size", "keytrk", "fine", "bendrg", "posx", "posy", "posvar", "strvar",
+    "exc", "hard", "velsns", "velhrd", "rough", "radius", "cspeed", "cforce", "reldmp", "trunc",
+    "poly", "width", "gain", "inmode", "ingain", "trigth", "retrig", "mix", "modwhl", "press",
+    "mpe", "mpebnd", "prune", "maskav", "spl", "prfrm", "budget", "load", "bypass",
 ];
 
 #[test]

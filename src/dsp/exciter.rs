@@ -223,8 +223,14 @@ impl Exciter {
     }
 
     /// Starts a strike of `amplitude` lasting `len_samples` (at least 1) from the next sample
-    /// rendered.
+    /// rendered. A contact kind strikes as a mallet (contacts start with
+    /// [`Exciter::start_contact`]).
     pub fn strike(&mut self, kind: ExciterKind, amplitude: f32, len_samples: u32) {
+        let kind = if kind.is_contact() {
+            ExciterKind::Mallet
+        } else {
+            kind
+        };
         let len = if kind == ExciterKind::Impulse {
             1
         } else {
@@ -270,14 +276,13 @@ impl Exciter {
             let p = &mut self.pulses[i];
             let n = ((p.len - p.pos) as usize).min(out.len());
             match p.kind {
-                // Contacts are not strikes: they never reach here.
-                ExciterKind::Scrape | ExciterKind::Roll => {}
                 ExciterKind::Impulse => {
                     if n > 0 {
                         out[0] += p.amplitude;
                     }
                 }
-                ExciterKind::Mallet => {
+                // Contacts strike as mallets.
+                ExciterKind::Mallet | ExciterKind::Scrape | ExciterKind::Roll => {
                     if p.len == 1 {
                         out[0] += p.amplitude;
                     } else {

@@ -13,7 +13,7 @@ use super::style;
 use crate::engine::Controls;
 use crate::model::factory::{factory_bank, factory_banks, factory_slug};
 use crate::model::{load_bank_file, save_bank_file, Bank};
-use crate::params::{MaterialChoice, ModalParams};
+use crate::params::{ExciterChoice, MaterialChoice, ModalParams};
 
 /// How often the user folder is listed again while the browser shows.
 const RESCAN_INTERVAL: Duration = Duration::from_secs(2);
@@ -276,7 +276,7 @@ impl BankBrowser {
 }
 
 /// Sets the parameters a bank's `defaults` name (material, tilt, hardness, strike position, key
-/// tracking), as the plugin does for its default bank.
+/// tracking, exciter and contact), as the plugin does for its default bank.
 pub fn apply_bank_defaults(bank: &Bank, params: &ModalParams, setter: &ParamSetter) {
     let c = Controls::for_bank(bank);
     let material = if c.material_q.is_some() {
@@ -293,6 +293,38 @@ pub fn apply_bank_defaults(bank: &Bank, params: &ModalParams, setter: &ParamSett
     set(setter, &params.strike.strike_x, c.strike_x);
     set(setter, &params.strike.strike_y, c.strike_y);
     set(setter, &params.object.key_tracking, c.key_tracking);
+    // The exciter a bank names; a bank that names none is struck, not scraped or rolled on.
+    let d = bank.defaults.clone().unwrap_or_default();
+    let contact = matches!(
+        params.strike.exciter.value(),
+        ExciterChoice::Scrape | ExciterChoice::Roll
+    );
+    if d.exciter.is_some() || contact {
+        set(setter, &params.strike.exciter, ExciterChoice::of(c.exciter));
+    }
+    let contact_defaults = [
+        (d.roughness, &params.strike.roughness, c.roughness),
+        (
+            d.rolling_radius_mm,
+            &params.strike.rolling_radius,
+            c.rolling_radius_mm,
+        ),
+        (
+            d.contact_speed_m_per_s,
+            &params.strike.contact_speed,
+            c.contact_speed_m_per_s,
+        ),
+        (
+            d.contact_force,
+            &params.strike.contact_force,
+            c.contact_force,
+        ),
+    ];
+    for (named, param, value) in contact_defaults {
+        if named.is_some() {
+            set(setter, param, value);
+        }
+    }
 }
 
 /// One whole host gesture setting `param` to `value`.

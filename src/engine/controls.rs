@@ -405,6 +405,19 @@ impl Controls {
             if let Some(k) = d.key_tracking_pct {
                 c.key_tracking = (k / 100.0) as f32;
             }
+            if let Some(kind) = d.exciter.as_deref().and_then(ExciterKind::from_name) {
+                c.exciter = kind;
+            }
+            for (value, control) in [
+                (d.roughness, &mut c.roughness),
+                (d.rolling_radius_mm, &mut c.rolling_radius_mm),
+                (d.contact_speed_m_per_s, &mut c.contact_speed_m_per_s),
+                (d.contact_force, &mut c.contact_force),
+            ] {
+                if let Some(v) = value {
+                    *control = v as f32;
+                }
+            }
         }
         c.sanitized()
     }

@@ -7,7 +7,7 @@ use super::controls::Controls;
 use super::position::{PositionMap, PositionWeights};
 use super::stereo::{balanced_pans, lane_weights, COLUMN_PAN};
 use crate::dsp::coeffs::{ModeCoeffs, MIN_DECAY_PER_S};
-use crate::dsp::{Exciter, Kernel, ResonatorBank, COLUMNS};
+use crate::dsp::{Exciter, ExciterKind, Kernel, ResonatorBank, COLUMNS};
 use crate::model::Bank;
 use crate::units::hz_to_midi_key;
 
@@ -217,7 +217,14 @@ impl PreparedBank {
         }
         let mut exciter = Exciter::new(1);
         let contact = (controls.hardness_ms as f64 * 1e-3 * MEASURE_RATE_HZ).round() as u32;
-        exciter.strike(controls.exciter, 1.0, contact);
+        // A bank played by a contact is set to the level of a mallet strike, which a contact at
+        // its defaults matches.
+        let kind = if controls.exciter.is_contact() {
+            ExciterKind::Mallet
+        } else {
+            controls.exciter
+        };
+        exciter.strike(kind, 1.0, contact);
         // Long enough for the slowest beating of the lowest modes to build up.
         let lowest = self.freq_hz.first().copied().unwrap_or(100.0).max(1.0);
         let peak_s = (4.0 / lowest).clamp(0.2, 1.0);

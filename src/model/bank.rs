@@ -107,6 +107,27 @@ pub struct BankDefaults {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[schemars(range(min = 0, max = 100))]
     pub key_tracking_pct: Option<f64>,
+    /// How the bank is played: a strike (`impulse`, `mallet`, `noise`) or a contact held with the
+    /// note (`scrape`, `roll`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(extend("enum" = ["impulse", "mallet", "noise", "scrape", "roll"]))]
+    pub exciter: Option<String>,
+    /// Roughness of a scraped or rolled surface and of a rolling object, 0 (smooth) to 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 0, max = 1))]
+    pub roughness: Option<f64>,
+    /// Radius of a rolling object in mm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 1, max = 200))]
+    pub rolling_radius_mm: Option<f64>,
+    /// Speed of a scrape or roll in m/s.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 0, max = 3))]
+    pub contact_speed_m_per_s: Option<f64>,
+    /// Force of a scrape or roll at full velocity, 0 to 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[schemars(range(min = 0, max = 1))]
+    pub contact_force: Option<f64>,
 }
 
 impl Bank {

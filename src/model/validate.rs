@@ -110,13 +110,23 @@ pub const HARDNESS_MS: NumberRange = NumberRange::closed(0.05, 20.0, " ms");
 
 /// `defaults` fields and their ranges, which are those of the matching host parameters. The
 /// typed walker lists the values of [`BankDefaults`](super::bank::BankDefaults) in this order.
-pub const DEFAULTS_RANGES: [(&str, NumberRange); 5] = [
+pub const DEFAULTS_RANGES: [(&str, NumberRange); 9] = [
     ("material_q", MATERIAL_Q),
     ("damping_tilt", DAMPING_TILT),
     ("hardness_ms", HARDNESS_MS),
     ("strike_position", NumberRange::closed(0.0, 1.0, "")),
     ("key_tracking_pct", NumberRange::closed(0.0, 100.0, "%")),
+    ("roughness", NumberRange::closed(0.0, 1.0, "")),
+    ("rolling_radius_mm", NumberRange::closed(1.0, 200.0, " mm")),
+    (
+        "contact_speed_m_per_s",
+        NumberRange::closed(0.0, 3.0, " m/s"),
+    ),
+    ("contact_force", NumberRange::closed(0.0, 1.0, "")),
 ];
+
+/// The exciters a bank's `defaults.exciter` may name (the engine's, by name).
+pub const EXCITER_NAMES: [&str; 5] = ["impulse", "mallet", "noise", "scrape", "roll"];
 
 /// One thing wrong with a bank.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -211,11 +221,26 @@ pub(crate) fn check_bank(bank: &Bank, problems: &mut Problems) {
             defaults.hardness_ms,
             defaults.strike_position,
             defaults.key_tracking_pct,
+            defaults.roughness,
+            defaults.rolling_radius_mm,
+            defaults.contact_speed_m_per_s,
+            defaults.contact_force,
         ];
         let path = root.field("defaults");
         for ((name, range), value) in DEFAULTS_RANGES.iter().zip(values) {
             if let Some(value) = value {
                 problems.check(&path.field(name), check_number(value, range));
+            }
+        }
+        if let Some(exciter) = &defaults.exciter {
+            if !EXCITER_NAMES.contains(&exciter.as_str()) {
+                problems.check(
+                    &path.field("exciter"),
+                    Err(format!(
+                        "expected one of {}, found \"{exciter}\"",
+                        EXCITER_NAMES.join(", ")
+                    )),
+                );
             }
         }
     }

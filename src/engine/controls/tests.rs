@@ -79,3 +79,10 @@ fn pruning_controls_are_set_by_name_within_their_ranges() {
     assert_eq!(c.target_load_pct, 50.0);
     assert!(c.set_by_name("target_load_pct", "150").is_err());
 }
+
+#[test]
+fn banks_name_exactly_the_engines_exciters() {
+    use crate::dsp::ExciterKind;
+    use crate::model::validate::EXCITER_NAMES;
+    assert_eq!(EXCITER_NAMES, ExciterKind::ALL.map(|k| k.name()));
+}

@@ -85,6 +85,23 @@ struct Tweaks {
     /// Name of the position struck by default, moved to the front, instead of the one nearest
     /// the family's usual strike point.
     strike_at: Option<&'static str>,
+    /// A contact the bank is played with by default, instead of a strike.
+    contact: Option<Contact>,
+}
+
+/// A contact a factory bank is played with: `defaults.exciter` and the contact's settings.
+#[derive(Debug, Clone, Copy)]
+struct Contact {
+    /// `scrape` or `roll`.
+    exciter: &'static str,
+    /// Roughness, 0 to 1.
+    roughness: f64,
+    /// Radius of a rolling object in mm (a roll only).
+    rolling_radius_mm: Option<f64>,
+    /// Speed in m/s.
+    speed_m_per_s: f64,
+    /// Force at full velocity, 0 to 1.
+    force: f64,
 }
 
 impl Tweaks {
@@ -92,6 +109,7 @@ impl Tweaks {
     const NONE: Tweaks = Tweaks {
         hardness_ms: None,
         strike_at: None,
+        contact: None,
     };
 }
 
@@ -118,6 +136,13 @@ impl FactoryObject {
         let defaults = bank.defaults.get_or_insert_with(Default::default);
         if let Some(hardness_ms) = self.tweaks.hardness_ms {
             defaults.hardness_ms = Some(hardness_ms);
+        }
+        if let Some(c) = self.tweaks.contact {
+            defaults.exciter = Some(c.exciter.to_string());
+            defaults.roughness = Some(c.roughness);
+            defaults.rolling_radius_mm = c.rolling_radius_mm;
+            defaults.contact_speed_m_per_s = Some(c.speed_m_per_s);
+            defaults.contact_force = Some(c.force);
         }
         if let Some(name) = self.tweaks.strike_at {
             strike_first(&mut bank, name)

@@ -1,6 +1,6 @@
 //! Factory banks of membranes, plates, discs and bells.
 
-use super::{key, FactoryObject, Tweaks};
+use super::{key, Contact, FactoryObject, Tweaks};
 use crate::model::materials;
 use crate::model::shapes::{
     CircularMembrane, CircularPlate, PlateEdge, RectangularMembrane, RectangularPlate, Shape,
@@ -102,6 +102,55 @@ pub(super) fn objects() -> Vec<FactoryObject> {
             tweaks: Tweaks::NONE,
         },
         FactoryObject {
+            name: "Scraped steel sheet",
+            description: "A thin steel sheet scraped with a metal edge for as long as a key is \
+                          held: a rasping, ringing screech that brightens as the scrape speeds \
+                          up (pressure sets the force, slide or the mod wheel the speed) and \
+                          rings on when it stops.",
+            shape: Shape::RectangularPlate(RectangularPlate {
+                length_x_m: 0.5,
+                length_y_m: 0.35,
+                thickness_m: 1.5e-3,
+            }),
+            material: &materials::STEEL,
+            root_key: key::E2,
+            tweaks: Tweaks {
+                // A sharp edge: a quarter of a millimetre of contact.
+                hardness_ms: Some(0.25),
+                contact: Some(Contact {
+                    exciter: "scrape",
+                    roughness: 0.6,
+                    rolling_radius_mm: None,
+                    speed_m_per_s: 0.4,
+                    force: 0.8,
+                }),
+                ..Tweaks::NONE
+            },
+        },
+        FactoryObject {
+            name: "Spruce table top (rolled ball)",
+            description: "A spruce table top with a wooden ball of 25 mm radius rolled across it \
+                          for as long as a key is held: a low rumble, the ball's own bumps \
+                          repeating once a revolution, faster as it rolls faster.",
+            shape: Shape::RectangularPlate(RectangularPlate {
+                length_x_m: 0.8,
+                length_y_m: 0.5,
+                thickness_m: 0.012,
+            }),
+            material: &materials::SPRUCE,
+            root_key: key::A2,
+            tweaks: Tweaks {
+                contact: Some(Contact {
+                    exciter: "roll",
+                    roughness: 0.5,
+                    rolling_radius_mm: Some(25.0),
+                    speed_m_per_s: 0.6,
+                    force: 0.8,
+                }),
+                ..Tweaks::NONE
+            },
+        },
+        FactoryObject {
             name: "Brass disc (cymbal-like)",
             description: "A thin flat brass disc free at its rim and struck on its bow with a \
                           stick: a bright, splashy wash of hundreds of inharmonic modes over a \
@@ -131,6 +180,7 @@ pub(super) fn objects() -> Vec<FactoryObject> {
             tweaks: Tweaks {
                 hardness_ms: Some(GONG_BEATER_MS),
                 strike_at: Some("third radius"),
+                contact: None,
             },
         },
         FactoryObject {

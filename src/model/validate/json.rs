@@ -9,7 +9,7 @@ use serde_json::{Map, Value};
 use super::{
     check_count, check_format, check_gains_len, check_name, check_number, check_version, quote,
     JsonPath, NumberRange, Problems, SameDimension, UniqueNames, COORD, DECAY_PER_S,
-    DEFAULTS_RANGES, FREQ_HZ, GAIN, MAX_MODES, MAX_POSITIONS, MODE_FREQ_HZ,
+    DEFAULTS_RANGES, EXCITER_NAMES, FREQ_HZ, GAIN, MAX_MODES, MAX_POSITIONS, MODE_FREQ_HZ,
 };
 use crate::model::bank::FORMAT_VERSION;
 
@@ -203,7 +203,22 @@ fn check_defaults(bank: &Map<String, Value>, root: &JsonPath<'_>, problems: &mut
     for (name, range) in &DEFAULTS_RANGES {
         check_number_field(defaults, &path, name, range, Presence::Optional, problems);
     }
-    let known = DEFAULTS_RANGES.map(|(name, _)| name);
+    let exciter_path = path.field("exciter");
+    if let Some(exciter) =
+        optional(defaults, "exciter").and_then(|value| string(value, &exciter_path, problems))
+    {
+        if !EXCITER_NAMES.contains(&exciter) {
+            problems.report(
+                &exciter_path,
+                format!(
+                    "expected one of {}, found \"{exciter}\"",
+                    EXCITER_NAMES.join(", ")
+                ),
+            );
+        }
+    }
+    let mut known: Vec<&str> = DEFAULTS_RANGES.iter().map(|(name, _)| *name).collect();
+    known.push("exciter");
     check_unknown_fields(defaults, &path, &known, problems);
 }
 
