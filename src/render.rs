@@ -199,7 +199,7 @@ struct TimedEvent {
 }
 
 /// The events of `notes` at `rate`, in the order the engine must see them.
-fn schedule(notes: &[Note], rate: f64) -> Vec<TimedEvent> {
+fn schedule(notes: &[Note], rate: f64, until_s: f64) -> Vec<TimedEvent> {
     let to_sample = |t: f64| (t * rate).round().max(0.0) as u64;
     let mut events = Vec::with_capacity(2 * notes.len());
     for note in notes {
@@ -209,7 +209,7 @@ fn schedule(notes: &[Note], rate: f64) -> Vec<TimedEvent> {
             rank: 1,
             event: NoteEvent::on(0, note.key, note.velocity),
         });
-        contact_curves(note, rate, &mut events);
+        contact_curves(note, rate, until_s, &mut events);
         if let Some(release_s) = note.release_s() {
             let off = to_sample(release_s).max(on);
             events.push(TimedEvent {
@@ -229,25 +229,28 @@ fn schedule(notes: &[Note], rate: f64) -> Vec<TimedEvent> {
 const CURVE_STEP_S: f64 = 0.002;
 
 /// A note's contact curves (speed, force) as the note's slide and pressure, from its strike to
-/// its release (or the strike alone, for a note held until it dies away).
-fn contact_curves(note: &Note, rate: f64, events: &mut Vec<TimedEvent>) {
-    if note.speed_m_per_s.is_none() && note.force.is_none() {
+/// its release (or the strike alone, for a note held until it dies away), up to `until_s`.
+fn contact_curves(note: &Note, rate: f64, until_s: f64, events: &mut Vec<TimedEvent>) {
+    if note.speed_m_per_s.is_none() && note.force.is_none() || note.time_s > until_s {
         return;
     }
     let duration = note.duration_s.unwrap_or(0.0);
-    let steps = (duration / CURVE_STEP_S).ceil() as usize;
+    // Points up to the end of the render only.
+    let heard = duration.min(until_s - note.time_s).max(0.0);
+    let steps = (heard / CURVE_STEP_S).ceil() as usize;
     let who = crate::engine::Note {
         key: note.key,
         channel: 0,
         id: None,
     };
     for i in 0..=steps {
-        let u = if steps == 0 {
+        let t = if steps == 0 {
             0.0
         } else {
-            i as f64 / steps as f64
+            heard * i as f64 / steps as f64
         };
-        let sample = ((note.time_s + u * duration) * rate).round() as u64;
+        let u = if duration > 0.0 { t / duration } else { 0.0 };
+        let sample = ((note.time_s + t) * rate).round() as u64;
         let at = |(a, b): (f64, f64)| (a + (b - a) * u) as f32;
         let mut push = |expression| {
             events.push(TimedEvent {
@@ -409,7 +412,7 @@ pub fn render_to<E>(
     engine.reserve_voices(settings.controls.polyphony);
     engine.prepare(settings.sample_rate_hz as f32, block);
 
-    let mut events = schedule(notes, rate);
+    let mut events = schedule(notes, rate, settings.max_seconds);
     // A release past the end changes nothing that is not still sounding at the cut; a strike
     // past it is a note not played.
     let dropped = events

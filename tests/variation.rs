@@ -5,10 +5,19 @@ mod common;
 
 use common::*;
 use modal_resonator::dsp::ExciterKind;
-use modal_resonator::engine::{Engine, NoteEvent, VARIATION_CENTS, VARIATION_GAIN_DB};
+use modal_resonator::engine::{
+    Engine, NoteEvent, VARIATION_CENTS, VARIATION_DECAY, VARIATION_GAIN_DB,
+};
 
 const RATE: f32 = 48_000.0;
 const STRIKES: usize = 12;
+
+/// Decay rate of the mode (per second) of the strike starting at `x[0]`: from its peaks over
+/// 10 ms at 20 ms and at 220 ms.
+fn decay_per_s(x: &[f32]) -> f64 {
+    let at = |t: f64| peak(&x[(t * RATE as f64) as usize..((t + 0.01) * RATE as f64) as usize]);
+    (at(0.02) as f64 / at(0.22) as f64).ln() / 0.2
+}
 
 /// Twelve strikes a second apart on fresh voices of a one-mode bank at 1 kHz (gone within the
 /// second), with strike variation `variation`: each strike's frequency and level over its first
@@ -46,7 +55,22 @@ fn strikes_vary_within_their_bounds_and_not_at_all_without_variation() {
             "strike {i}"
         );
     }
-    let (f, l, _) = strikes(1.0);
+    let (f, l, x) = strikes(1.0);
+    let second = RATE as usize;
+    let decays: Vec<f64> = (0..STRIKES)
+        .map(|i| decay_per_s(&x[i * second..]) / 20.0 - 1.0)
+        .collect();
+    println!("decay {decays:.3?} of 20 /s");
+    assert!(
+        decays
+            .iter()
+            .all(|d| d.abs() <= VARIATION_DECAY as f64 + 0.005),
+        "decay varies beyond its bound: {decays:.3?}"
+    );
+    assert!(
+        decays.iter().any(|d| d.abs() > 0.01),
+        "decay hardly varies: {decays:.3?}"
+    );
     let cents: Vec<f64> = f.iter().map(|x| 1200.0 * (x / f0[0]).log2()).collect();
     let db: Vec<f64> = l.iter().map(|x| x - l0[0]).collect();
     println!("pitch {cents:.2?} cents, level {db:.2?} dB");

@@ -7,7 +7,9 @@
 //! speed `v`, a spatial frequency `k` sounds at `k v`: a faster scrape is brighter, the whole
 //! spectrum sliding up with speed. The profile is a sum of octaves of smooth value noise (a
 //! lattice of random heights per octave, eased between lattice points), each leaving the sum as
-//! its frequency at the current speed nears the Nyquist frequency, so nothing aliases.
+//! its frequency at the current speed nears the Nyquist frequency (eased value noise has some
+//! energy above its lattice rate, which the contact's low-pass and the object's modes mostly
+//! leave unheard).
 //!
 //! - **Scrape**: the profile seen through the contact (a low-pass whose corner is the speed over
 //!   the width of the contact: a hard, sharp scraper feels finer detail), its rate of change
@@ -34,8 +36,12 @@ const LOWEST_CYCLES_PER_M: f64 = 200.0;
 const OCTAVES: usize = 14;
 
 /// Lattice cells of the lowest octave before the profile repeats (and the position wraps): 2^20
-/// cells of 5 mm, 5 km of surface.
-const PERIOD_CELLS: f64 = 1_048_576.0;
+/// cells of 5 mm, 5 km of surface. Every octave's lattice repeats there too, so the wrap is
+/// seamless.
+const PERIOD_CELLS: f64 = (1u64 << PERIOD_BITS) as f64;
+
+/// `log2` of [`PERIOD_CELLS`].
+const PERIOD_BITS: u32 = 20;
 
 /// How deep a rolling object sinks into the ground, in metres: its contact patch is `sqrt(2 r d)`.
 const INDENTATION_M: f64 = 1e-5;
@@ -47,16 +53,17 @@ const BUMPS: usize = 8;
 /// Width of a bump, as a share of the spacing between bumps.
 const BUMP_WIDTH: f64 = 0.25;
 
-/// Gain of a rolling object's ground noise, a tenth of its bumps' (seed 004 section 5.3 turns
-/// the ground down too): the bumps carry the roll's rhythm.
+/// Gain of a rolling object's ground noise, a fortieth of its bumps' (seed 004 section 5.3
+/// turns the ground down too): the bumps carry the roll's rhythm.
 const GROUND_GAIN: f32 = 0.4;
 
-/// Force of a rolling object's tallest bump, relative: a roll at 0.6 m/s on the factory table
-/// drives it about as hard as a scrape at 0.4 m/s drives the factory steel sheet.
+/// Force of a rolling object's tallest bump, relative: held, the factory table rolled on at
+/// 0.6 m/s peaks at -10.4 dBFS, the factory steel sheet scraped at 0.4 m/s at -6.2 dBFS
+/// (`tests/factory_presets.rs`).
 const BUMP_GAIN: f32 = 16.0;
 
 /// The vertical velocity is in units of the profile's RMS per lowest-octave cell crossed at this
-/// speed, metres per second (a scrape at 0.5 m/s through a 0.5 mm contact has an RMS of about 6).
+/// speed, metres per second.
 const REFERENCE_SPEED_M_PER_S: f64 = 1.0;
 
 /// How an object touches the surface.
@@ -101,6 +108,10 @@ pub struct Contact {
     low_pass: f32,
     /// The low-pass's output one sample earlier.
     last: f32,
+    /// The low-pass coefficient, and the speed it is for.
+    pole: f32,
+    /// See `pole`.
+    pole_speed: f64,
     /// Sample rate, Hz.
     sample_rate_hz: f64,
     /// Smoothing coefficient per sample.
@@ -148,6 +159,8 @@ impl Contact {
             force: 0.0,
             low_pass: 0.0,
             last: 0.0,
+            pole: 0.0,
+            pole_speed: 0.0,
             sample_rate_hz,
             smoothing: 1.0 - (-1.0 / (SMOOTHING_S * sample_rate_hz)).exp(),
         }
@@ -156,6 +169,12 @@ impl Contact {
     /// Roughness, 0 to 1.
     pub fn roughness(&self) -> f32 {
         self.roughness
+    }
+
+    /// Moves the contact point to `cells` lattice cells of the lowest octave along the surface
+    /// (wrapped to the surface's length), without smoothing: for a contact starting afresh.
+    pub fn move_to(&mut self, cells: u32) {
+        self.position_cells = cells as f64 % PERIOD_CELLS;
     }
 
     /// Scrape or roll, and its size.
@@ -168,6 +187,8 @@ impl Contact {
     pub fn set_kind(&mut self, kind: ContactKind) {
         if std::mem::discriminant(&kind) == std::mem::discriminant(&self.kind) {
             self.kind = kind;
+            // The low-pass's corner moves with the width.
+            self.pole_speed = f64::NAN;
         }
     }
 
@@ -208,13 +229,23 @@ impl Contact {
         let slope_scale = (1.0 / reference_cells) as f32;
         for y in out.iter_mut() {
             self.speed += (target_speed - self.speed) * k;
+            if (target_speed - self.speed).abs() < 1e-9 {
+                self.speed = target_speed;
+            }
             self.force += (target_force - self.force) * k as f32;
             let cells = self.speed * dt * LOWEST_CYCLES_PER_M;
-            self.position_cells = (self.position_cells + cells) % PERIOD_CELLS;
+            self.position_cells += cells;
+            if self.position_cells >= PERIOD_CELLS {
+                self.position_cells -= PERIOD_CELLS;
+            }
             let height = self.profile();
-            // The contact's low-pass: corner at speed over width.
-            let corner_hz = self.speed / width_m;
-            let a = 1.0 - (-TAU * corner_hz * dt).exp() as f32;
+            // The contact's low-pass: corner at speed over width (recomputed only as the speed
+            // moves).
+            if self.speed != self.pole_speed {
+                self.pole_speed = self.speed;
+                self.pole = 1.0 - (-TAU * self.speed / width_m * dt).exp() as f32;
+            }
+            let a = self.pole;
             self.low_pass += (height - self.low_pass) * a;
             // Vertical velocity: the change of height per sample, in profile RMS per lattice
             // cell of the reference speed.
@@ -245,7 +276,8 @@ impl Contact {
             if weight == 0.0 {
                 break;
             }
-            sum += weight * gain * value_noise(self.seed, k as u32, self.position_cells * scale);
+            let x = self.position_cells * scale;
+            sum += weight * gain * value_noise(self.seed, k as u32, x);
             freq_hz *= 2.0;
             scale *= 2.0;
         }
@@ -273,15 +305,18 @@ impl Contact {
 /// to normalise the profile.
 const VALUE_NOISE_RMS: f32 = 0.48;
 
-/// Smooth value noise at `x` lattice cells: random heights in [-1, 1] at whole cells, eased
-/// between them (smoothstep), so the profile has no kinks.
+/// Smooth value noise of `octave` at `x` lattice cells: random heights in [-1, 1] at whole
+/// cells, eased between them (smoothstep), so the profile has no kinks. The lattice repeats
+/// every `PERIOD_CELLS << octave` cells.
 #[inline]
 fn value_noise(seed: u32, octave: u32, x: f64) -> f32 {
     let cell = x.floor();
     let t = (x - cell) as f32;
-    let i = cell as i64 as u32;
-    let a = unit(hash(seed, octave, i));
-    let b = unit(hash(seed, octave, i.wrapping_add(1)));
+    let mask = (1u64 << (PERIOD_BITS + octave)) - 1;
+    let i = cell as u64 & mask;
+    // Hashed on the low 32 bits and the octave: distinct within a period of up to 2^32 cells.
+    let a = unit(hash(seed, octave, i as u32));
+    let b = unit(hash(seed, octave, ((i + 1) & mask) as u32));
     let s = t * t * (3.0 - 2.0 * t);
     a + (b - a) * s
 }

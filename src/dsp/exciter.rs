@@ -9,9 +9,9 @@ use std::f32::consts::TAU;
 use super::contact::{Contact, ContactKind};
 use super::rng::Rng;
 
-/// Level of a contact's force against a strike's: a scrape at 0.5 m/s and full force, held,
-/// drives a bank to about the level of the first half second of a mallet strike at full
-/// velocity (measured on a bank of 200 modes from 110 Hz in `tests/contact.rs`).
+/// Level of a contact's force against a strike's: a scrape at 0.5 m/s and the default force
+/// (0.7), held, drives a bank to about the level of the first half second of a mallet strike at
+/// full velocity (0.1 dB apart on a bank of 200 modes from 110 Hz in `tests/contact.rs`).
 const CONTACT_GAIN: f32 = 3.7e-4;
 
 /// How many overlapping strikes one voice keeps; a further strike replaces the oldest.
@@ -82,7 +82,7 @@ impl ExciterKind {
         match self {
             ExciterKind::Impulse | ExciterKind::Mallet => 1.0,
             ExciterKind::Noise => (len_samples.max(1) as f32).sqrt(),
-            // A contact's force is at most its normal force times a few (the profile's peaks).
+            // Contacts strike as mallets (a contact's own force is not bounded in advance).
             ExciterKind::Scrape | ExciterKind::Roll => 1.0,
         }
     }
@@ -124,6 +124,9 @@ pub struct Exciter {
     contact: Contact,
     /// Whether a contact is under way: held, or dying away after its release.
     in_contact: bool,
+    /// Whether the contact under way has been let go: it ends once its force has died away. A
+    /// contact held at no force carries on (a player may press again).
+    contact_released: bool,
     /// Where the contact's speed is going, m/s.
     contact_speed: f32,
     /// Where the contact's normal force is going, 0 to 1.
@@ -149,6 +152,7 @@ impl Exciter {
             count: 0,
             contact: Contact::new(ContactKind::Scrape { width_m: 1e-3 }, 0.5, seed, 48_000.0),
             in_contact: false,
+            contact_released: false,
             contact_speed: 0.0,
             contact_force: 0.0,
             rng: Rng::new(seed),
@@ -160,6 +164,7 @@ impl Exciter {
     pub fn reset(&mut self) {
         self.count = 0;
         self.in_contact = false;
+        self.contact_released = false;
         self.contact.reset();
         self.rng = Rng::new(self.seed);
     }
@@ -190,21 +195,29 @@ impl Exciter {
             && self.contact.roughness() == roughness;
         if !same {
             self.contact = Contact::new(kind, roughness, self.seed, sample_rate_hz);
+            // Each contact starts somewhere else on the surface.
+            self.contact.move_to(self.rng.next_u32());
         } else {
             self.contact.set_kind(kind);
         }
         self.in_contact = true;
-        self.set_contact(speed_m_per_s, force);
-    }
-
-    /// Moves the contact under way towards `speed_m_per_s` and `force`.
-    pub fn set_contact(&mut self, speed_m_per_s: f32, force: f32) {
+        self.contact_released = false;
         self.contact_speed = speed_m_per_s;
         self.contact_force = force;
     }
 
+    /// Moves the contact under way towards `speed_m_per_s` and `force`, unless it has been let
+    /// go.
+    pub fn set_contact(&mut self, speed_m_per_s: f32, force: f32) {
+        if !self.contact_released {
+            self.contact_speed = speed_m_per_s;
+            self.contact_force = force;
+        }
+    }
+
     /// Lets the contact go: its force falls to nothing, and it ends.
     pub fn release_contact(&mut self) {
+        self.contact_released = true;
         self.contact_force = 0.0;
     }
 
@@ -267,7 +280,7 @@ impl Exciter {
         if self.in_contact {
             self.contact
                 .render(self.contact_speed, CONTACT_GAIN * self.contact_force, out);
-            if self.contact_force == 0.0 && self.contact.is_silent() {
+            if self.contact_released && self.contact.is_silent() {
                 self.in_contact = false;
             }
         }

@@ -5,7 +5,10 @@ mod by_name;
 
 use super::position::PositionMap;
 use crate::dsp::ExciterKind;
-use crate::model::validate::{DAMPING_TILT, HARDNESS_MS, MATERIAL_Q};
+use crate::model::validate::{
+    NumberRange, CONTACT_FORCE, CONTACT_SPEED_M_PER_S, DAMPING_TILT, HARDNESS_MS, MATERIAL_Q,
+    ROLLING_RADIUS_MM, ROUGHNESS,
+};
 use crate::model::Bank;
 
 /// Most voices the engine can play at once.
@@ -259,16 +262,34 @@ pub const NUMERIC_CONTROLS: &[ControlSpec] = &[
     ),
     spec!("velocity_sensitivity", "", 0.0, 1.0, velocity_sensitivity),
     spec!("velocity_to_hardness", "", 0.0, 1.0, velocity_to_hardness),
-    spec!("roughness", "", 0.0, 1.0, roughness),
-    spec!("rolling_radius_mm", "mm", 1.0, 200.0, rolling_radius_mm),
+    spec!(
+        "roughness",
+        "",
+        span(ROUGHNESS).0,
+        span(ROUGHNESS).1,
+        roughness
+    ),
+    spec!(
+        "rolling_radius_mm",
+        "mm",
+        span(ROLLING_RADIUS_MM).0,
+        span(ROLLING_RADIUS_MM).1,
+        rolling_radius_mm
+    ),
     spec!(
         "contact_speed_m_per_s",
         "m/s",
-        0.0,
-        CONTACT_SPEED_MAX_M_PER_S,
+        span(CONTACT_SPEED_M_PER_S).0,
+        span(CONTACT_SPEED_M_PER_S).1,
         contact_speed_m_per_s
     ),
-    spec!("contact_force", "", 0.0, 1.0, contact_force),
+    spec!(
+        "contact_force",
+        "",
+        span(CONTACT_FORCE).0,
+        span(CONTACT_FORCE).1,
+        contact_force
+    ),
     spec!("release_damping", "", 0.0, 1.0, release_damping),
     spec!("extra_damping", "", 0.0, 1.0, extra_damping),
     spec!("truncation_db", "dBFS", -140.0, -60.0, truncation_db),
@@ -354,7 +375,12 @@ pub const VARIATION_DECAY: f32 = 0.05;
 pub const VARIATION_GAIN_DB: f32 = 1.5;
 
 /// Fastest scrape or roll, in m/s: a quick stroke of the hand.
-pub const CONTACT_SPEED_MAX_M_PER_S: f32 = 3.0;
+pub const CONTACT_SPEED_MAX_M_PER_S: f32 = CONTACT_SPEED_M_PER_S.max as f32;
+
+/// A model range as the `(min, max)` of a control.
+const fn span(range: NumberRange) -> (f32, f32) {
+    (range.min as f32, range.max as f32)
+}
 
 /// Range of the masking offset `a_v` in dB (seed 001 found 5 dB transparent, 20 dB the
 /// laboratory figure for tone-on-tone masking).

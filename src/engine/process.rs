@@ -415,15 +415,10 @@ impl Engine {
         let c = &self.controls;
         let v = &mut self.voices[i];
         let o = v.overrides;
+        // On a contact note pressure is the contact's force, not a hand damping the object.
+        v.contact = c.exciter.is_contact();
         let variation = c.strike_variation;
-        (v.variation_semitones, v.variation_log_damping) = if variation > 0.0 {
-            (
-                variation * VARIATION_CENTS / 100.0 * self.rng.bipolar(),
-                (1.0 + variation * VARIATION_DECAY * self.rng.bipolar()).ln(),
-            )
-        } else {
-            (0.0, 0.0)
-        };
+        (v.variation_semitones, v.variation_log_damping) = draw_variation(variation, &mut self.rng);
         if pending.fresh {
             v.log_pitch =
                 target_log_pitch(c, self.bank.root_key, v.key, &o) + expression_log_pitch(v);
@@ -442,13 +437,7 @@ impl Engine {
         }
         let weights = self.bank.positions.weights(x, y);
         self.bank.gains_at(&weights, &mut self.strike_gains);
-        if variation > 0.0 {
-            // Each mode's gain within the variation's dB either way.
-            let spread = variation * VARIATION_GAIN_DB / DB_PER_NEPER;
-            for g in &mut self.strike_gains {
-                *g *= (spread * self.rng.bipolar()).exp();
-            }
-        }
+        vary_gains(variation, &mut self.rng, &mut self.strike_gains);
         // Force: velocity^(2 s); contact: up to 4x longer for soft notes.
         let velocity = pending.velocity;
         let amplitude = velocity.powf(2.0 * c.velocity_sensitivity);
@@ -485,15 +474,24 @@ impl Engine {
         if start_dormant || self.voices[i].modes.num_dormant() > 0 {
             self.settle_strike(i, kind, amplitude, len);
         }
+        if kind.is_contact() {
+            self.start_contact(i, kind, amplitude, hardness_ms);
+        }
+    }
+
+    /// Starts voice `i`'s contact of `kind` (a scrape or roll) at velocity-derived force
+    /// `amplitude`, its width from `hardness_ms`. A note released at the sample it started
+    /// (a click on the strike pad, a note of no length) lets go of it at once.
+    fn start_contact(&mut self, i: usize, kind: ExciterKind, amplitude: f32, hardness_ms: f32) {
+        let c = &self.controls;
         let v = &mut self.voices[i];
-        v.contact = kind.is_contact();
-        if v.contact {
-            let c = &self.controls;
-            v.contact_velocity = amplitude;
-            let (speed, force) = contact_targets(c, v);
-            let shape = contact_shape(c, kind, hardness_ms);
-            v.exciter
-                .start_contact(shape, c.roughness, self.sample_rate_hz, speed, force);
+        v.contact_velocity = amplitude;
+        let (speed, force) = contact_targets(c, v);
+        let shape = contact_shape(c, kind, hardness_ms);
+        v.exciter
+            .start_contact(shape, c.roughness, self.sample_rate_hz, speed, force);
+        if v.state != VoiceState::Held {
+            v.exciter.release_contact();
         }
     }
 
@@ -671,7 +669,28 @@ fn target_log_pitch(c: &Controls, root_key: f64, key: u8, overrides: &VoiceOverr
     semitones * std::f64::consts::LN_2 / 12.0 - (size_ratio as f64).ln()
 }
 
-/// The pitch offset of a voice's per-note tuning, as a natural log of the frequency ratio.
+/// A strike's random change of pitch (semitones) and decay (natural log of its multiplier) at
+/// strike variation `variation`: none at 0.
+fn draw_variation(variation: f32, rng: &mut Rng) -> (f32, f32) {
+    if variation <= 0.0 {
+        return (0.0, 0.0);
+    }
+    (
+        variation * VARIATION_CENTS / 100.0 * rng.bipolar(),
+        (1.0 + variation * VARIATION_DECAY * rng.bipolar()).ln(),
+    )
+}
+
+/// Each mode's gain in `gains` moved at random within the variation's dB either way.
+fn vary_gains(variation: f32, rng: &mut Rng, gains: &mut [f32]) {
+    if variation > 0.0 {
+        let spread = variation * VARIATION_GAIN_DB / DB_PER_NEPER;
+        for g in gains {
+            *g *= (spread * rng.bipolar()).exp();
+        }
+    }
+}
+
 /// Width of a scrape's contact per ms of hardness, in metres: the default 0.25 ms scrapes through
 /// a quarter of a millimetre (a corner at 2 kHz at 0.5 m/s), a soft 5 ms through 5 mm.
 const SCRAPE_WIDTH_M_PER_MS: f64 = 1e-3;
@@ -689,19 +708,22 @@ fn contact_shape(c: &Controls, kind: ExciterKind, hardness_ms: f32) -> ContactKi
 }
 
 /// Where a contact note's speed (m/s) and force are going: the note's slide, else the contact
-/// speed; the note's pressure once it has come, else its velocity, times the contact force.
+/// speed; the note's own pressure once it has pressed, else the contact force (which the
+/// channel's pressure or mod wheel may set) times its velocity.
 fn contact_targets(c: &Controls, v: &Voice) -> (f32, f32) {
     let speed = v
         .slide
         .map_or(c.contact_speed_m_per_s, |s| s * CONTACT_SPEED_MAX_M_PER_S);
-    let level = if v.pressed {
+    let force = if v.pressed {
         v.pressure
     } else {
-        v.contact_velocity
+        c.contact_force * v.contact_velocity
     };
-    (speed, c.contact_force * level)
+    (speed, force)
 }
 
+/// The pitch offset of a voice's per-note tuning and its strike's variation, as a natural log of
+/// the frequency ratio.
 fn expression_log_pitch(v: &Voice) -> f64 {
     (v.tuning_semitones + v.variation_semitones) as f64 * std::f64::consts::LN_2 / 12.0
 }

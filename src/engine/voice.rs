@@ -109,7 +109,8 @@ pub struct Voice {
     pub contact: bool,
     /// A contact note's force from its velocity, until pressure takes over (0 to 1).
     pub contact_velocity: f32,
-    /// Whether pressure has come for the note since it started: it then sets a contact's force.
+    /// Whether the note's pressure has been above 0 since it started: it then sets a contact's
+    /// force.
     pub pressed: bool,
     /// Per-note slide 0 to 1 (note expression, MPE's CC 74): a contact's speed, if it came.
     pub slide: Option<f32>,
@@ -175,7 +176,9 @@ impl Voice {
             }
             NoteExpression::Pressure(p) if p.is_finite() => {
                 self.pressure = p.clamp(0.0, 1.0);
-                self.pressed = true;
+                // A note's pressure takes over a contact's force once it presses at all (MPE
+                // sends the channel's resting pressure, 0, with each note).
+                self.pressed |= self.pressure > 0.0;
             }
             NoteExpression::Slide(s) if s.is_finite() => self.slide = Some(s.clamp(0.0, 1.0)),
             _ => {}

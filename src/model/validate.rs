@@ -108,6 +108,19 @@ pub const DAMPING_TILT: NumberRange = NumberRange::closed(-2.0, 2.0, "");
 /// parameter; every strike's contact time is held to it.
 pub const HARDNESS_MS: NumberRange = NumberRange::closed(0.05, 20.0, " ms");
 
+/// Roughness of a scraped or rolled surface, 0 (smooth) to 1: a bank's default, the engine's
+/// control and the host parameter.
+pub const ROUGHNESS: NumberRange = NumberRange::closed(0.0, 1.0, "");
+
+/// Radius of a rolling object in mm, from a bead to a bowling ball.
+pub const ROLLING_RADIUS_MM: NumberRange = NumberRange::closed(1.0, 200.0, " mm");
+
+/// Speed of a scrape or roll in m/s, up to a quick stroke of the hand.
+pub const CONTACT_SPEED_M_PER_S: NumberRange = NumberRange::closed(0.0, 3.0, " m/s");
+
+/// Force of a scrape or roll at full velocity, 0 to 1.
+pub const CONTACT_FORCE: NumberRange = NumberRange::closed(0.0, 1.0, "");
+
 /// `defaults` fields and their ranges, which are those of the matching host parameters. The
 /// typed walker lists the values of [`BankDefaults`](super::bank::BankDefaults) in this order.
 pub const DEFAULTS_RANGES: [(&str, NumberRange); 9] = [
@@ -116,13 +129,10 @@ pub const DEFAULTS_RANGES: [(&str, NumberRange); 9] = [
     ("hardness_ms", HARDNESS_MS),
     ("strike_position", NumberRange::closed(0.0, 1.0, "")),
     ("key_tracking_pct", NumberRange::closed(0.0, 100.0, "%")),
-    ("roughness", NumberRange::closed(0.0, 1.0, "")),
-    ("rolling_radius_mm", NumberRange::closed(1.0, 200.0, " mm")),
-    (
-        "contact_speed_m_per_s",
-        NumberRange::closed(0.0, 3.0, " m/s"),
-    ),
-    ("contact_force", NumberRange::closed(0.0, 1.0, "")),
+    ("roughness", ROUGHNESS),
+    ("rolling_radius_mm", ROLLING_RADIUS_MM),
+    ("contact_speed_m_per_s", CONTACT_SPEED_M_PER_S),
+    ("contact_force", CONTACT_FORCE),
 ];
 
 /// The exciters a bank's `defaults.exciter` may name (the engine's, by name).

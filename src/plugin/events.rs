@@ -46,6 +46,8 @@ pub struct Expression {
     pub channel_bend: [f32; CHANNELS],
     /// Pressure of each MPE member channel, 0 to 1.
     pub channel_pressure: [f32; CHANNELS],
+    /// Slide (CC 74) of each MPE member channel, 0 to 1, if it has been sent.
+    pub channel_slide: [Option<f32>; CHANNELS],
 }
 
 impl Expression {
@@ -129,6 +131,13 @@ impl<K: Kind> ModalPlugin<K> {
                                 time: timing,
                                 note,
                                 expression: NoteExpression::Pressure(pressure),
+                            });
+                        }
+                        if let Some(slide) = self.expression.channel_slide[c] {
+                            self.push(EngineEvent::Expression {
+                                time: timing,
+                                note,
+                                expression: NoteExpression::Slide(slide),
                             });
                         }
                     }
@@ -284,11 +293,15 @@ impl<K: Kind> ModalPlugin<K> {
                     cc: SLIDE_CC,
                     channel,
                     value,
-                } if is_member(channel) => self.push(EngineEvent::ChannelExpression {
-                    time: timing,
-                    channel,
-                    expression: NoteExpression::Slide(value.clamp(0.0, 1.0)),
-                }),
+                } if is_member(channel) => {
+                    let slide = value.clamp(0.0, 1.0);
+                    self.expression.channel_slide[channel as usize % CHANNELS] = Some(slide);
+                    self.push(EngineEvent::ChannelExpression {
+                        time: timing,
+                        channel,
+                        expression: NoteExpression::Slide(slide),
+                    })
+                }
                 NoteEvent::MidiCC {
                     timing, cc, value, ..
                 } => match cc {

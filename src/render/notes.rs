@@ -88,9 +88,14 @@ fn parse_note(item: &str) -> Result<Note, String> {
     if item.is_empty() {
         return Err(format!("empty item: expected {NOTE_SYNTAX}"));
     }
-    let mut words = item.split_whitespace();
-    let mut note = parse_strike(words.next().unwrap_or_default())?;
-    for word in words {
+    // The strike runs up to the first word naming a curve (whitespace around its fields is
+    // allowed); the curves follow, one word each.
+    let curves_at = item
+        .split_whitespace()
+        .find(|w| w.contains('='))
+        .map_or(item.len(), |w| w.as_ptr() as usize - item.as_ptr() as usize);
+    let mut note = parse_strike(&item[..curves_at])?;
+    for word in item[curves_at..].split_whitespace() {
         let (name, value) = word
             .split_once('=')
             .ok_or_else(|| format!("\"{word}\": expected speed=A..B or force=A..B"))?;
@@ -199,7 +204,8 @@ mod tests {
                 "force: expected a number from 0 to 1",
             ),
             ("60:1@0+1 pitch=3", "\"pitch\": expected speed or force"),
-            ("60:1@0+1 speed", "expected speed=A..B"),
+            ("60:1@0+1 speed", "duration: expected a number"),
+            ("60:1@0+1 speed=1 x", "\"x\": expected speed=A..B"),
         ] {
             let err = parse_notes(text).unwrap_err();
             assert!(
