@@ -108,6 +108,8 @@ pub struct Contact {
     low_pass: f32,
     /// The low-pass's output one sample earlier.
     last: f32,
+    /// Each octave's last lattice cell and the heights either side of it.
+    lattice: [(u64, (f32, f32)); OCTAVES],
     /// The low-pass coefficient, and the speed it is for.
     pole: f32,
     /// See `pole`.
@@ -159,6 +161,7 @@ impl Contact {
             force: 0.0,
             low_pass: 0.0,
             last: 0.0,
+            lattice: [(u64::MAX, (0.0, 0.0)); OCTAVES],
             pole: 0.0,
             pole_speed: 0.0,
             sample_rate_hz,
@@ -265,19 +268,30 @@ impl Contact {
 
     /// The surface's height at the contact point: the sum of the octaves still under the
     /// Nyquist frequency at the current speed.
-    fn profile(&self) -> f32 {
+    fn profile(&mut self) -> f32 {
         let nyquist_hz = 0.5 * self.sample_rate_hz;
         let mut sum = 0.0f32;
         let mut freq_hz = self.speed * LOWEST_CYCLES_PER_M;
         let mut scale = 1.0;
-        for (k, &gain) in self.octave_gain.iter().enumerate() {
+        for k in 0..OCTAVES {
             // Full weight up to half the Nyquist frequency, none from it on.
             let weight = (2.0 - 2.0 * freq_hz / nyquist_hz).clamp(0.0, 1.0) as f32;
             if weight == 0.0 {
                 break;
             }
             let x = self.position_cells * scale;
-            sum += weight * gain * value_noise(self.seed, k as u32, x);
+            let cell = x.floor();
+            let t = (x - cell) as f32;
+            // The lattice heights either side, hashed again only when the cell changes (most
+            // samples stay in one).
+            let cached = &mut self.lattice[k];
+            let i = cell as u64 & ((1u64 << (PERIOD_BITS + k as u32)) - 1);
+            if cached.0 != i {
+                *cached = (i, lattice_heights(self.seed, k as u32, i));
+            }
+            let (a, b) = cached.1;
+            let s = t * t * (3.0 - 2.0 * t);
+            sum += weight * self.octave_gain[k] * (a + (b - a) * s);
             freq_hz *= 2.0;
             scale *= 2.0;
         }
@@ -301,24 +315,21 @@ impl Contact {
     }
 }
 
-/// RMS of [`value_noise`] over a long path (lattice values uniform in [-1, 1], eased): measured,
+/// RMS of the eased lattice heights over a long path (lattice values uniform in [-1, 1], eased): measured,
 /// to normalise the profile.
 const VALUE_NOISE_RMS: f32 = 0.48;
 
-/// Smooth value noise of `octave` at `x` lattice cells: random heights in [-1, 1] at whole
-/// cells, eased between them (smoothstep), so the profile has no kinks. The lattice repeats
-/// every `PERIOD_CELLS << octave` cells.
+/// The random heights in [-1, 1) of `octave`'s lattice at cell `i` and the next: the profile
+/// eases between them (smoothstep), so it has no kinks. The lattice repeats every
+/// `PERIOD_CELLS << octave` cells.
 #[inline]
-fn value_noise(seed: u32, octave: u32, x: f64) -> f32 {
-    let cell = x.floor();
-    let t = (x - cell) as f32;
+fn lattice_heights(seed: u32, octave: u32, i: u64) -> (f32, f32) {
     let mask = (1u64 << (PERIOD_BITS + octave)) - 1;
-    let i = cell as u64 & mask;
     // Hashed on the low 32 bits and the octave: distinct within a period of up to 2^32 cells.
-    let a = unit(hash(seed, octave, i as u32));
-    let b = unit(hash(seed, octave, ((i + 1) & mask) as u32));
-    let s = t * t * (3.0 - 2.0 * t);
-    a + (b - a) * s
+    (
+        unit(hash(seed, octave, i as u32)),
+        unit(hash(seed, octave, ((i + 1) & mask) as u32)),
+    )
 }
 
 /// A 32-bit hash of a lattice point.
