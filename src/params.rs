@@ -360,6 +360,21 @@ fn percent(name: &str, default: f32) -> FloatParam {
 /// Range of the onset trigger's threshold in dB: the input mode's own, with no engine control.
 const TRIGGER_THRESHOLD_RANGE_DB: (f32, f32) = (-80.0, 0.0);
 
+/// A parameter over the range of the numeric control `control`, skewed by `skew` (negative
+/// gives the low end more of the travel).
+fn skewed(name: &str, default: f32, control: &str, skew: f32) -> FloatParam {
+    let (min, max) = control_range(control);
+    FloatParam::new(
+        name,
+        default,
+        FloatRange::Skewed {
+            min,
+            max,
+            factor: FloatRange::skew_factor(skew),
+        },
+    )
+}
+
 /// A linear range from `(min, max)`.
 fn linear((min, max): (f32, f32)) -> FloatRange {
     FloatRange::Linear { min, max }
@@ -426,40 +441,26 @@ impl ModalParams {
                 position_variation: percent("Position variation", 0.0),
                 strike_variation: percent("Strike variation", 0.0),
                 exciter: EnumParam::new("Exciter", ExciterChoice::of(d.exciter)),
-                hardness: FloatParam::new(
-                    "Hardness",
-                    d.hardness_ms,
-                    FloatRange::Skewed {
-                        min: control_range("hardness_ms").0,
-                        max: control_range("hardness_ms").1,
-                        factor: FloatRange::skew_factor(-2.5),
-                    },
-                )
-                .with_unit(" ms")
-                .with_step_size(0.01)
-                .with_poly_modulation_id(poly_id::HARDNESS),
+                hardness: skewed("Hardness", d.hardness_ms, "hardness_ms", -2.5)
+                    .with_unit(" ms")
+                    .with_step_size(0.01)
+                    .with_poly_modulation_id(poly_id::HARDNESS),
                 velocity_sensitivity: percent("Velocity sensitivity", 0.8),
                 velocity_to_hardness: percent("Velocity to hardness", 0.5),
                 roughness: percent("Roughness", d.roughness),
-                rolling_radius: FloatParam::new(
+                rolling_radius: skewed(
                     "Rolling radius",
                     d.rolling_radius_mm,
-                    FloatRange::Skewed {
-                        min: control_range("rolling_radius_mm").0,
-                        max: control_range("rolling_radius_mm").1,
-                        factor: FloatRange::skew_factor(-1.5),
-                    },
+                    "rolling_radius_mm",
+                    -1.5,
                 )
                 .with_unit(" mm")
                 .with_step_size(0.1),
-                contact_speed: FloatParam::new(
+                contact_speed: skewed(
                     "Contact speed",
                     d.contact_speed_m_per_s,
-                    FloatRange::Skewed {
-                        min: control_range("contact_speed_m_per_s").0,
-                        max: control_range("contact_speed_m_per_s").1,
-                        factor: FloatRange::skew_factor(-1.0),
-                    },
+                    "contact_speed_m_per_s",
+                    -1.0,
                 )
                 .with_unit(" m/s")
                 .with_step_size(0.01),

@@ -269,13 +269,14 @@ impl Contact {
     /// The surface's height at the contact point: the sum of the octaves still under the
     /// Nyquist frequency at the current speed.
     fn profile(&mut self) -> f32 {
-        let nyquist_hz = 0.5 * self.sample_rate_hz;
+        // An octave's weight falls from 1 at half the Nyquist frequency to 0 at it.
+        let per_hz = 4.0 / self.sample_rate_hz;
         let mut sum = 0.0f32;
         let mut freq_hz = self.speed * LOWEST_CYCLES_PER_M;
         let mut scale = 1.0;
         for k in 0..OCTAVES {
             // Full weight up to half the Nyquist frequency, none from it on.
-            let weight = (2.0 - 2.0 * freq_hz / nyquist_hz).clamp(0.0, 1.0) as f32;
+            let weight = (2.0 - freq_hz * per_hz).clamp(0.0, 1.0) as f32;
             if weight == 0.0 {
                 break;
             }

@@ -174,11 +174,6 @@ impl Exciter {
         self.count == 0 && !self.in_contact
     }
 
-    /// Whether a contact is under way (held, or dying away after its release).
-    pub fn in_contact(&self) -> bool {
-        self.in_contact
-    }
-
     /// Starts a contact of `kind` at `roughness` moving towards `speed_m_per_s` and `force`
     /// from the next sample (from no force, so without a click); a contact of the same kind
     /// under way carries on towards them.

@@ -171,14 +171,7 @@ fn parse_strike(item: &str) -> Result<Note, String> {
             })
         })
         .transpose()?;
-    Ok(Note {
-        key,
-        velocity,
-        time_s,
-        duration_s,
-        speed_m_per_s: None,
-        force: None,
-    })
+    Ok(Note::new(key, velocity, time_s, duration_s))
 }
 
 /// A finite number, or `None`.
