@@ -82,6 +82,9 @@ pub enum ExciterChoice {
     /// Rolling on a rough surface while the note is held.
     #[id = "roll"]
     Roll,
+    /// Rubbing with stick-slip friction while the note is held: a wine glass, a singing bowl.
+    #[id = "rub"]
+    Rub,
 }
 
 impl ExciterChoice {
@@ -93,6 +96,19 @@ impl ExciterChoice {
             ExciterKind::Noise => ExciterChoice::Noise,
             ExciterKind::Scrape => ExciterChoice::Scrape,
             ExciterKind::Roll => ExciterChoice::Roll,
+            ExciterKind::Rub => ExciterChoice::Rub,
+        }
+    }
+
+    /// The exciter this choice plays.
+    pub fn kind(self) -> ExciterKind {
+        match self {
+            ExciterChoice::Mallet => ExciterKind::Mallet,
+            ExciterChoice::Impulse => ExciterKind::Impulse,
+            ExciterChoice::Noise => ExciterKind::Noise,
+            ExciterChoice::Scrape => ExciterKind::Scrape,
+            ExciterChoice::Roll => ExciterKind::Roll,
+            ExciterChoice::Rub => ExciterKind::Rub,
         }
     }
 }
@@ -637,13 +653,7 @@ impl ModalParams {
             strike_y: self.strike.strike_y.value(),
             position_variation: self.strike.position_variation.value(),
             strike_variation: self.strike.strike_variation.value(),
-            exciter: match self.strike.exciter.value() {
-                ExciterChoice::Mallet => ExciterKind::Mallet,
-                ExciterChoice::Impulse => ExciterKind::Impulse,
-                ExciterChoice::Noise => ExciterKind::Noise,
-                ExciterChoice::Scrape => ExciterKind::Scrape,
-                ExciterChoice::Roll => ExciterKind::Roll,
-            },
+            exciter: self.strike.exciter.value().kind(),
             roughness: self.strike.roughness.value(),
             rolling_radius_mm: self.strike.rolling_radius.value(),
             contact_speed_m_per_s,

@@ -275,3 +275,50 @@ fn a_contact_held_at_no_force_waits_for_pressure_and_one_released_at_once_lets_g
         "still {end} against {start} at the start"
     );
 }
+
+fn zero_crossing_hz(x: &[f32]) -> f64 {
+    let crossings: Vec<f64> = x
+        .windows(2)
+        .enumerate()
+        .filter(|(_, w)| w[0] < 0.0 && w[1] >= 0.0)
+        .map(|(i, w)| i as f64 + (w[0] / (w[0] - w[1])) as f64)
+        .collect();
+    let (first, last) = (crossings[0], crossings[crossings.len() - 1]);
+    (crossings.len() - 1) as f64 * RATE as f64 / (last - first)
+}
+
+#[test]
+fn a_rubbed_glass_sings_at_its_clearest_mode_while_held_and_rings_on_after() {
+    // A glass: its lowest rim mode rings longest and moves most at the rim.
+    let bank = simple_bank(&[
+        (660.0, 0.4, 1.0),
+        (1_580.0, 1.5, 0.6),
+        (2_830.0, 3.0, 0.4),
+        (4_350.0, 5.0, 0.3),
+    ]);
+    let mut e = contact_engine(&bank, ExciterKind::Rub, 0.2);
+    let x = play(&mut e, &[on(0, KEY, 1.0), release_at(4.0)], 6.0);
+    let held = span(&x, 3.0, 4.0);
+    let hz = zero_crossing_hz(held);
+    let cents = 1200.0 * (hz / 660.0).log2();
+    let (a, b) = (rms(span(&x, 3.0, 3.5)), rms(span(&x, 3.5, 4.0)));
+    println!(
+        "rubbed at 0.2 m/s: {hz:.2} Hz ({cents:+.2} cents), {:.1} dBFS",
+        20.0 * b.log10()
+    );
+    assert!(cents.abs() < 5.0, "sings at {hz:.2} Hz");
+    assert!((20.0 * (b / a).log10()).abs() < 0.5, "not steady: {a} then {b}");
+    // Let go, it rings on at its own decay (0.4 /s: -1.7 dB in 0.5 s) and dies away.
+    let (after, later) = (rms(span(&x, 4.2, 4.7)), rms(span(&x, 5.2, 5.7)));
+    assert!(after > 0.5 * b && after < b, "after release {after} against {b}");
+    let db = 20.0 * (later / after).log10();
+    assert!((-5.5..-2.0).contains(&db), "rings on {db:.1} dB a second later");
+    // Click-free: the song grows from nothing, and letting go leaves no step larger than the
+    // song's own (1 % for the stick-slip's jitter).
+    let steady = max_step(held);
+    let (start, stop) = (max_step(span(&x, 0.0, 0.1)), max_step(span(&x, 4.0, 4.1)));
+    assert!(
+        start <= 0.1 * steady && stop <= 1.01 * steady,
+        "steps {start} at the start, {stop} at the stop, {steady} held"
+    );
+}

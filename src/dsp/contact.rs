@@ -1,5 +1,6 @@
-//! Continuous contact: the force of an object scraped or rolled along a rough surface, computed
-//! per sample from a few slowly varying inputs (contact speed and normal force).
+//! Continuous contact: the force of an object scraped or rolled along a rough surface, or rubbed
+//! by a finger or a stick, computed per sample from a few slowly varying inputs (contact speed and
+//! normal force).
 //!
 //! Both read a *surface profile* at the contact point as it moves (seed 000 section 4.3, after van
 //! den Doel, Kry and Pai's FoleyAutomatic): the height of the surface along the path, fractal noise
@@ -20,6 +21,22 @@
 //!   more, so a large ball rolls duller), plus the object's own bumps: eight per revolution, at a
 //!   rate of speed over circumference, whose height and irregularity is the roughness: a perfect
 //!   ball has none, an irregular one a pattern that repeats once a revolution.
+//!
+//! - **Rub**: stick-slip friction driving the object through its own motion, as a bow drives a
+//!   bar (bowed-bar style, after McIntyre, Schumacher and Woodhouse's friction-driven
+//!   oscillators): the force is the normal force times a friction coefficient that depends on
+//!   the *relative* velocity `dv` of rubber and object at the contact point,
+//!   `mu(dv) = tanh(K dv / v0) (mu_d + (mu_s - mu_d) / (1 + |dv| / v0))`: the object sticks
+//!   while `dv` is small and slides with friction falling as `dv` grows. Where it slides, that
+//!   falling friction feeds energy into the modes moving with the rubber (negative damping);
+//!   a mode whose loss is smaller than that gain grows until it sticks and slips once a cycle, and
+//!   then sings steadily at its own frequency: a wine glass or a singing bowl. Below a force
+//!   threshold no mode gains more than it loses, and the object stays silent. The object's
+//!   velocity at the contact point is the sum of its modes' velocities (see
+//!   [`crate::dsp::resonator_bank::ResonatorBank::process_rubbed`]), one sample old, so the
+//!   friction is computed explicitly; the stick stiffness is set so that this one-sample loop
+//!   gains at most [`RUB_LOOP_GAIN`] per sample whatever the bank. The force is high-passed at
+//!   [`RUB_DC_HZ`], so the steady drag does not push the object off its rest position.
 //!
 //! Speed and force are smoothed over [`SMOOTHING_S`], and the force starts from zero, so a contact
 //! starts, stops and moves without a click.
@@ -66,6 +83,39 @@ const BUMP_GAIN: f32 = 16.0;
 /// speed, metres per second.
 const REFERENCE_SPEED_M_PER_S: f64 = 1.0;
 
+/// Static friction coefficient of a rub (at the edge of sticking).
+const RUB_STATIC: f32 = 1.0;
+
+/// Sliding friction coefficient of a rub, far from sticking.
+const RUB_DYNAMIC: f32 = 0.4;
+
+/// Relative velocity over which a rub's friction falls from static towards sliding, m/s.
+const RUB_FALL_M_PER_S: f32 = 0.2;
+
+/// Steepness of a rub's sticking branch: the friction reaches its static value within
+/// `RUB_FALL_M_PER_S / RUB_STICK` of sticking.
+const RUB_STICK: f32 = 10.0;
+
+/// How much the contact point's velocity may answer a change of friction force within one sample,
+/// relative: the rub's sticking branch is never steeper than this share of the explicit loop's
+/// stability limit (1).
+pub const RUB_LOOP_GAIN: f32 = 0.5;
+
+/// Acceleration of the contact point under full friction at full force, m/s^2 (the friction
+/// force over the mass the contact point moves).
+const RUB_ACCELERATION: f64 = 150.0;
+
+/// Fastest rub, m/s: a rub's level follows its speed.
+const RUB_MAX_SPEED_M_PER_S: f64 = 10.0;
+
+/// Corner of the high-pass on a rub's force, Hz.
+pub const RUB_DC_HZ: f64 = 5.0;
+
+/// The object's velocity at the contact point, m/s, per unit of the modes' summed velocity
+/// (the state the resonators hold for a unit impulse): a rub's steady oscillation swings the
+/// contact point at about the rubbing speed, so this sets its level.
+const RUB_M_PER_S_PER_UNIT: f32 = 2.0;
+
 /// How an object touches the surface.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ContactKind {
@@ -79,6 +129,8 @@ pub enum ContactKind {
         /// Radius, metres.
         radius_m: f64,
     },
+    /// Rubbing it: stick-slip friction (its force from [`Contact::rub`], not [`Contact::render`]).
+    Rub,
 }
 
 /// The contact force of one object on one surface.
@@ -114,6 +166,12 @@ pub struct Contact {
     pole: f32,
     /// See `pole`.
     pole_speed: f64,
+    /// A rub's force before its high-pass, one sample earlier.
+    rub_last: f32,
+    /// A rub's force after its high-pass.
+    rub_out: f32,
+    /// The high-pass's pole.
+    rub_pole: f32,
     /// Sample rate, Hz.
     sample_rate_hz: f64,
     /// Smoothing coefficient per sample.
@@ -164,6 +222,9 @@ impl Contact {
             lattice: [(u64::MAX, (0.0, 0.0)); OCTAVES],
             pole: 0.0,
             pole_speed: 0.0,
+            rub_last: 0.0,
+            rub_out: 0.0,
+            rub_pole: (-std::f64::consts::TAU * RUB_DC_HZ / sample_rate_hz).exp() as f32,
             sample_rate_hz,
             smoothing: 1.0 - (-1.0 / (SMOOTHING_S * sample_rate_hz)).exp(),
         }
@@ -201,6 +262,8 @@ impl Contact {
         self.force = 0.0;
         self.low_pass = 0.0;
         self.last = 0.0;
+        self.rub_last = 0.0;
+        self.rub_out = 0.0;
     }
 
     /// Whether the smoothed force has died away (the contact has ended).
@@ -210,23 +273,16 @@ impl Contact {
 
     /// Adds the contact force for the next `out.len()` samples into `out`, as
     /// speed and force move towards `speed_m_per_s` and `force` (relative, 1 is a firm touch).
-    /// Non-finite or negative inputs count as zero.
+    /// Non-finite or negative inputs count as zero. A rub adds nothing here: its force answers
+    /// the object's motion, sample by sample ([`Contact::rub`]).
     pub fn render(&mut self, speed_m_per_s: f32, force: f32, out: &mut [f32]) {
-        let target_speed = if speed_m_per_s.is_finite() {
-            speed_m_per_s.max(0.0) as f64
-        } else {
-            0.0
-        };
-        let target_force = if force.is_finite() {
-            force.max(0.0)
-        } else {
-            0.0
-        };
+        let (target_speed, target_force) = targets(speed_m_per_s, force);
         let k = self.smoothing;
         let dt = 1.0 / self.sample_rate_hz;
         let width_m = match self.kind {
             ContactKind::Scrape { width_m } => width_m.max(1e-6),
             ContactKind::Roll { radius_m } => (2.0 * radius_m.max(1e-4) * INDENTATION_M).sqrt(),
+            ContactKind::Rub => return,
         };
         let reference_cells = REFERENCE_SPEED_M_PER_S * dt * LOWEST_CYCLES_PER_M;
         let slope_scale = (1.0 / reference_cells) as f32;
@@ -262,8 +318,45 @@ impl Contact {
                         self.revolution = (self.revolution + turn).fract();
                         GROUND_GAIN * slope + BUMP_GAIN * self.bumps()
                     }
+                    ContactKind::Rub => 0.0,
                 };
         }
+    }
+
+    /// A rub's force on the object for the next sample, as speed and force move towards
+    /// `speed_m_per_s` and `force` (relative, 1 is a firm touch; non-finite or negative count as
+    /// zero), given the object's velocity at the contact point now: `velocity`, the sum of its
+    /// modes' velocities with the sign of their gains, and `gain_sum`, the sum of their gains'
+    /// magnitudes (how far that velocity moves for a unit force in one sample).
+    #[inline]
+    pub fn rub(
+        &mut self,
+        speed_m_per_s: f32,
+        force: f32,
+        velocity: f32,
+        gain_sum: f32,
+    ) -> f32 {
+        let (target_speed, target_force) = targets(speed_m_per_s, force);
+        let target_speed = target_speed.min(RUB_MAX_SPEED_M_PER_S);
+        let k = self.smoothing;
+        self.speed += (target_speed - self.speed) * k;
+        self.force += (target_force - self.force) * k as f32;
+        let relative = (self.speed as f32 - RUB_M_PER_S_PER_UNIT * velocity) / RUB_FALL_M_PER_S;
+        // A unit force moves the contact point `RUB_M_PER_S_PER_UNIT * gain_sum` in one sample:
+        // full friction at full force accelerates it at `RUB_ACCELERATION`.
+        let per_sample = (RUB_ACCELERATION / self.sample_rate_hz) as f32;
+        let scale = per_sample / (RUB_M_PER_S_PER_UNIT * gain_sum.max(1e-12));
+        // The sticking branch as steep as asked, or as the one-sample loop allows at this force.
+        let stick = RUB_STICK
+            .min(RUB_LOOP_GAIN * RUB_FALL_M_PER_S / (per_sample * RUB_STATIC * self.force));
+        let friction = (stick * relative).tanh()
+            * (RUB_DYNAMIC + (RUB_STATIC - RUB_DYNAMIC) / (1.0 + relative.abs()));
+        let drag = self.force * scale * friction;
+        let drag = if drag.is_finite() { drag } else { 0.0 };
+        // One-pole high-pass: y = p (y + x - x_prev).
+        self.rub_out = self.rub_pole * (self.rub_out + drag - self.rub_last);
+        self.rub_last = drag;
+        self.rub_out
     }
 
     /// The surface's height at the contact point: the sum of the octaves still under the
@@ -314,6 +407,21 @@ impl Contact {
         }
         sum
     }
+}
+
+/// Speed and force targets with non-finite or negative values taken as zero.
+fn targets(speed_m_per_s: f32, force: f32) -> (f64, f32) {
+    let speed = if speed_m_per_s.is_finite() {
+        speed_m_per_s.max(0.0) as f64
+    } else {
+        0.0
+    };
+    let force = if force.is_finite() {
+        force.max(0.0)
+    } else {
+        0.0
+    };
+    (speed, force)
 }
 
 /// RMS of the eased lattice heights over a long path (lattice values uniform in [-1, 1], eased): measured,

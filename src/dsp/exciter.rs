@@ -32,16 +32,19 @@ pub enum ExciterKind {
     Scrape,
     /// Rolling for as long as the note is held ([`super::contact`]).
     Roll,
+    /// Rubbing for as long as the note is held: stick-slip friction ([`super::contact`]).
+    Rub,
 }
 
 impl ExciterKind {
     /// Every kind, for parameter lists.
-    pub const ALL: [ExciterKind; 5] = [
+    pub const ALL: [ExciterKind; 6] = [
         ExciterKind::Impulse,
         ExciterKind::Mallet,
         ExciterKind::Noise,
         ExciterKind::Scrape,
         ExciterKind::Roll,
+        ExciterKind::Rub,
     ];
 
     /// Lowercase name.
@@ -52,6 +55,7 @@ impl ExciterKind {
             ExciterKind::Noise => "noise",
             ExciterKind::Scrape => "scrape",
             ExciterKind::Roll => "roll",
+            ExciterKind::Rub => "rub",
         }
     }
 
@@ -60,9 +64,13 @@ impl ExciterKind {
         Self::ALL.into_iter().find(|k| k.name() == name)
     }
 
-    /// Whether the exciter is a contact held with the note (scrape, roll) rather than a strike.
+    /// Whether the exciter is a contact held with the note (scrape, roll, rub) rather than a
+    /// strike.
     pub fn is_contact(self) -> bool {
-        matches!(self, ExciterKind::Scrape | ExciterKind::Roll)
+        matches!(
+            self,
+            ExciterKind::Scrape | ExciterKind::Roll | ExciterKind::Rub
+        )
     }
 
     /// The strike's shape when it is known in full in advance (impulse, mallet); `None` for
@@ -72,7 +80,9 @@ impl ExciterKind {
         match self {
             ExciterKind::Impulse => Some(PulseShape::Impulse),
             ExciterKind::Mallet => Some(PulseShape::Mallet),
-            ExciterKind::Noise | ExciterKind::Scrape | ExciterKind::Roll => None,
+            ExciterKind::Noise | ExciterKind::Scrape | ExciterKind::Roll | ExciterKind::Rub => {
+                None
+            }
         }
     }
 
@@ -83,7 +93,7 @@ impl ExciterKind {
             ExciterKind::Impulse | ExciterKind::Mallet => 1.0,
             ExciterKind::Noise => (len_samples.max(1) as f32).sqrt(),
             // Contacts strike as mallets (a contact's own force is not bounded in advance).
-            ExciterKind::Scrape | ExciterKind::Roll => 1.0,
+            ExciterKind::Scrape | ExciterKind::Roll | ExciterKind::Rub => 1.0,
         }
     }
 }
@@ -120,7 +130,7 @@ pub struct Exciter {
     pulses: [StrikeUnderWay; MAX_PULSES],
     /// Number of active pulses.
     count: usize,
-    /// The contact held with the note (scrape, roll), while `in_contact`.
+    /// The contact held with the note (scrape, roll, rub), while `in_contact`.
     contact: Contact,
     /// Whether a contact is under way: held, or dying away after its release.
     in_contact: bool,
@@ -216,6 +226,23 @@ impl Exciter {
         self.contact_force = 0.0;
     }
 
+    /// Whether a rub is under way: its force comes sample by sample from [`Exciter::rub_force`]
+    /// rather than from [`Exciter::render`].
+    pub fn is_rubbing(&self) -> bool {
+        self.in_contact && self.contact.kind() == ContactKind::Rub
+    }
+
+    /// The rub's force for the next sample, given the object's velocity at the contact point
+    /// and the sum of its gains' magnitudes ([`Contact::rub`]). Zero when no rub is under way.
+    #[inline]
+    pub fn rub_force(&mut self, velocity: f32, gain_sum: f32) -> f32 {
+        if !self.is_rubbing() {
+            return 0.0;
+        }
+        self.contact
+            .rub(self.contact_speed, self.contact_force, velocity, gain_sum)
+    }
+
     /// How many strikes are under way.
     pub fn num_under_way(&self) -> usize {
         self.count
@@ -290,7 +317,7 @@ impl Exciter {
                     }
                 }
                 // Contacts strike as mallets.
-                ExciterKind::Mallet | ExciterKind::Scrape | ExciterKind::Roll => {
+                ExciterKind::Mallet | ExciterKind::Scrape | ExciterKind::Roll | ExciterKind::Rub => {
                     if p.len == 1 {
                         out[0] += p.amplitude;
                     } else {

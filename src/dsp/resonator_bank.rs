@@ -317,6 +317,45 @@ impl ResonatorBank {
         );
     }
 
+    /// Like [`ResonatorBank::process`], but one sample at a time, each sample's input being
+    /// `input`'s plus the force `friction` returns from the object's velocity at the contact
+    /// point and the sum of the gains' magnitudes: a rub ([`crate::dsp::contact`]). A mode's
+    /// velocity is the real part of its phasor (the imaginary part, its output, is its
+    /// displacement); each counts with the sign of its gain, so that every mode moves the contact
+    /// point the way the force pushes it. The velocity is the state before the sample, which the
+    /// sample's input first reaches.
+    pub fn process_rubbed(
+        &mut self,
+        kernel: Kernel,
+        input: &[f32],
+        mut friction: impl FnMut(f32, f32) -> f32,
+        acc: &mut [[f32; COLUMNS]],
+    ) {
+        if self.coeffs_stale {
+            self.refresh_coeffs();
+        }
+        let n = self.num_computed(kernel);
+        let gain_sum: f32 = self.gain[..n].iter().map(|g| g.abs()).sum();
+        for (x, sum) in input.iter().zip(acc.iter_mut()) {
+            let velocity = signed_sum(&self.re[..n], &self.gain[..n]);
+            let drive = x + friction(velocity, gain_sum);
+            self.clock += 1;
+            self.computed += n as u64;
+            kernels::process(
+                kernel,
+                Rows {
+                    re: &mut self.re[..n],
+                    im: &mut self.im[..n],
+                    q_re: &self.q_re[..n],
+                    q_im: &self.q_im[..n],
+                    gain: &self.gain[..n],
+                },
+                Some(std::slice::from_ref(&drive)),
+                std::slice::from_mut(sum),
+            );
+        }
+    }
+
     /// Stops every steady computed mode whose amplitude `|z|` is below `threshold` and re-packs
     /// the columns (fading modes, and modes with a ghost, finish their fades first). Returns how
     /// many modes stopped.
@@ -455,6 +494,17 @@ impl ResonatorBank {
 
 /// How many of the states `re + i im` have `|z|^2` not above `threshold_sq` (not-a-number
 /// counts).
+/// The sum of `re` with the signs of `gain`, in eight independent lanes (so it vectorises).
+fn signed_sum(re: &[f32], gain: &[f32]) -> f32 {
+    let mut lanes = [0.0f32; COLUMNS];
+    for (r, g) in re.chunks_exact(COLUMNS).zip(gain.chunks_exact(COLUMNS)) {
+        for j in 0..COLUMNS {
+            lanes[j] += f32::from_bits(r[j].to_bits() ^ (g[j].to_bits() & 0x8000_0000));
+        }
+    }
+    lanes.iter().sum()
+}
+
 fn count_not_above(re: &[f32], im: &[f32], threshold_sq: f32) -> usize {
     #[cfg(target_arch = "x86_64")]
     {

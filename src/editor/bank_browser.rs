@@ -295,10 +295,7 @@ pub fn apply_bank_defaults(bank: &Bank, params: &ModalParams, setter: &ParamSett
     set(setter, &params.object.key_tracking, c.key_tracking);
     // The exciter a bank names; a bank that names none is struck, not scraped or rolled on.
     let d = bank.defaults.clone().unwrap_or_default();
-    let contact = matches!(
-        params.strike.exciter.value(),
-        ExciterChoice::Scrape | ExciterChoice::Roll
-    );
+    let contact = params.strike.exciter.value().kind().is_contact();
     if d.exciter.is_some() || contact {
         set(setter, &params.strike.exciter, ExciterChoice::of(c.exciter));
     }

@@ -507,11 +507,10 @@ impl Engine {
                 continue;
             }
             let driven = v.exciter.render(x);
-            let drive = driven.then_some(&x[..]);
             if v.state == VoiceState::Fading {
                 let fade = &mut self.fade_acc[..n];
                 fade.fill([0.0; COLUMNS]);
-                v.modes.process(self.kernel, drive, fade);
+                drive_voice(v, self.kernel, driven, x, fade);
                 for (a, f) in acc.iter_mut().zip(fade.iter()) {
                     v.fade_gain = (v.fade_gain - fade_step).max(0.0);
                     for j in 0..COLUMNS {
@@ -522,7 +521,7 @@ impl Engine {
                     end_voice(v, &mut self.ended, self.block_pos);
                 }
             } else {
-                v.modes.process(self.kernel, drive, acc);
+                drive_voice(v, self.kernel, driven, x, acc);
             }
         }
         self.drive_input_voice(input, n);
@@ -649,6 +648,22 @@ impl Engine {
 
 /// One smoothing step from `current` towards `target` by fraction `k`, snapping to the target
 /// once within `snap`.
+/// Advances voice `v`'s modes over a run, driven by `x` when `driven` (its exciter's strikes and
+/// scrape or roll), and by its rub's friction sample by sample while it is rubbed.
+fn drive_voice(v: &mut Voice, kernel: Kernel, driven: bool, x: &[f32], out: &mut [[f32; COLUMNS]]) {
+    if v.exciter.is_rubbing() {
+        let exciter = &mut v.exciter;
+        v.modes.process_rubbed(
+            kernel,
+            x,
+            |velocity, gain_sum| exciter.rub_force(velocity, gain_sum),
+            out,
+        );
+    } else {
+        v.modes.process(kernel, driven.then_some(x), out);
+    }
+}
+
 fn step_towards(current: f64, target: f64, k: f64, snap: f64) -> f64 {
     let next = current + (target - current) * k;
     if (target - next).abs() <= snap || !next.is_finite() {
@@ -701,6 +716,7 @@ fn contact_shape(c: &Controls, kind: ExciterKind, hardness_ms: f32) -> ContactKi
         ExciterKind::Roll => ContactKind::Roll {
             radius_m: c.rolling_radius_mm as f64 * 1e-3,
         },
+        ExciterKind::Rub => ContactKind::Rub,
         _ => ContactKind::Scrape {
             width_m: hardness_ms as f64 * SCRAPE_WIDTH_M_PER_MS,
         },

@@ -108,9 +108,9 @@ pub struct BankDefaults {
     #[schemars(range(min = 0, max = 100))]
     pub key_tracking_pct: Option<f64>,
     /// How the bank is played: a strike (`impulse`, `mallet`, `noise`) or a contact held with the
-    /// note (`scrape`, `roll`).
+    /// note (`scrape`, `roll`, `rub`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[schemars(extend("enum" = ["impulse", "mallet", "noise", "scrape", "roll"]))]
+    #[schemars(extend("enum" = ["impulse", "mallet", "noise", "scrape", "roll", "rub"]))]
     pub exciter: Option<String>,
     /// Roughness of a scraped or rolled surface and of a rolling object, 0 (smooth) to 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -136,7 +136,7 @@ pub const DEFAULTS_RANGES: [(&str, NumberRange); 9] = [
 ];
 
 /// The exciters a bank's `defaults.exciter` may name (the engine's, by name).
-pub const EXCITER_NAMES: [&str; 5] = ["impulse", "mallet", "noise", "scrape", "roll"];
+pub const EXCITER_NAMES: [&str; 6] = ["impulse", "mallet", "noise", "scrape", "roll", "rub"];
 
 /// One thing wrong with a bank.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -8,7 +8,7 @@ use nice_plug::prelude::*;
 use super::{Kind, ModalPlugin, MAX_EVENTS};
 use crate::editor::Audition;
 use crate::engine::{Note, NoteEvent as EngineEvent, NoteExpression};
-use crate::params::{ExciterChoice, ExpressionTarget};
+use crate::params::ExpressionTarget;
 
 /// MIDI CC 74 (sound controller 5, "brightness"): MPE's slide, the third dimension of a note.
 const SLIDE_CC: u8 = 74;
@@ -85,11 +85,8 @@ impl<K: Kind> ModalPlugin<K> {
         let mpe = self.params.voices.mpe.value();
         let mpe_range = self.params.voices.mpe_bend_range.value();
         // Per-note pressure damps a struck note when routed to damping, and is the force of a
-        // contact note (scrape, roll) whatever the routing.
-        let contact = matches!(
-            self.params.strike.exciter.value(),
-            ExciterChoice::Scrape | ExciterChoice::Roll
-        );
+        // contact note (scrape, roll, rub) whatever the routing.
+        let contact = self.params.strike.exciter.value().kind().is_contact();
         let pressure_damps =
             contact || self.params.voices.pressure_target.value() == ExpressionTarget::Damping;
         let is_member = |channel: u8| mpe && channel != MPE_MANAGER_CHANNEL;

@@ -211,3 +211,109 @@ fn bad_inputs_give_silence_not_noise() {
     x.extend(render(&mut c, 2.0, 1e3, 0.05));
     assert!(x.iter().all(|v| v.is_finite()));
 }
+
+/// Modes `(freq_hz, decay_per_s, gain)` rubbed at `speed` and `force` for `seconds`: their
+/// summed output.
+fn rub_modes(modes: &[(f64, f64, f32)], speed: f32, force: f32, seconds: f64) -> Vec<f32> {
+    use crate::dsp::coeffs::ModeCoeffs;
+    use crate::dsp::kernels::{Kernel, COLUMNS};
+    use crate::dsp::resonator_bank::ResonatorBank;
+    let mut bank = ResonatorBank::new(modes.len());
+    for (k, &(freq_hz, decay_per_s, gain)) in modes.iter().enumerate() {
+        bank.activate(k, ModeCoeffs::from_freq_decay(RATE, freq_hz, decay_per_s), gain);
+    }
+    let mut c = Contact::new(ContactKind::Rub, 0.5, 7, RATE);
+    let zeros = [0.0f32; 64];
+    let mut out = Vec::new();
+    for _ in 0..(seconds * RATE / 64.0) as usize {
+        let mut acc = [[0.0f32; COLUMNS]; 64];
+        bank.process_rubbed(Kernel::detect(), &zeros, |v, g| c.rub(speed, force, v, g), &mut acc);
+        out.extend(acc.iter().map(|a| a.iter().sum::<f32>()));
+    }
+    out
+}
+
+/// Frequency of `x` from its first and last upward zero crossings (interpolated), Hz.
+fn zero_crossing_hz(x: &[f32]) -> f64 {
+    let crossings: Vec<f64> = x
+        .windows(2)
+        .enumerate()
+        .filter(|(_, w)| w[0] < 0.0 && w[1] >= 0.0)
+        .map(|(i, w)| i as f64 + (w[0] / (w[0] - w[1])) as f64)
+        .collect();
+    let (first, last) = (crossings[0], crossings[crossings.len() - 1]);
+    (crossings.len() - 1) as f64 * RATE / (last - first)
+}
+
+fn tail(x: &[f32], seconds: f64) -> &[f32] {
+    &x[x.len() - (seconds * RATE) as usize..]
+}
+
+#[test]
+fn a_rubbed_high_q_mode_sings_steadily_at_its_own_frequency() {
+    for (freq_hz, gain) in [(440.0, 0.01f32), (1234.5, 1.0)] {
+        for (speed, force) in [(0.1f32, 0.5f32), (0.3, 0.5), (0.3, 1.0)] {
+            let x = rub_modes(&[(freq_hz, 0.5, gain)], speed, force, 4.0);
+            let hz = zero_crossing_hz(tail(&x, 1.0));
+            let cents = 1200.0 * (hz / freq_hz).log2();
+            let (a, b) = (rms(&tail(&x, 0.5)[..24_000]), rms(tail(&x, 0.25)));
+            let drift_db = 20.0 * (b / a).log10();
+            println!(
+                "{freq_hz} Hz at {speed} m/s, force {force}: {cents:+.2} cents, \
+                 {:.1} dBFS, {drift_db:+.3} dB over the last 0.25 s",
+                20.0 * b.log10()
+            );
+            assert!(cents.abs() < 5.0, "{freq_hz} Hz sings at {hz:.2} Hz");
+            assert!(drift_db.abs() < 0.2, "not steady: {drift_db:.2} dB");
+            // Its level is set by the rubbing speed (the contact point swings at about the
+            // speed), not by the mode's gain.
+            assert!(
+                (0.2..0.6).contains(&(b / speed as f64)),
+                "level {b:.3} at {speed} m/s"
+            );
+        }
+    }
+}
+
+#[test]
+fn below_a_force_threshold_a_rubbed_mode_stays_silent_and_a_lossier_one_needs_more() {
+    let forces = [0.005f32, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0];
+    let threshold = |decay_per_s: f64| {
+        let sings: Vec<bool> = forces
+            .iter()
+            .map(|&f| rms(tail(&rub_modes(&[(660.0, decay_per_s, 0.1)], 0.2, f, 6.0), 0.5)) > 0.01)
+            .collect();
+        println!("decay {decay_per_s} /s: {sings:?}");
+        // Silent below, singing from the threshold up.
+        let first = sings.iter().position(|&s| s).expect("never sings");
+        assert!(first > 0, "sings at the lightest touch");
+        assert!(sings[first..].iter().all(|&s| s), "{sings:?}");
+        forces[first]
+    };
+    let (clear, lossy) = (threshold(0.3), threshold(3.0));
+    assert!(lossy > clear, "threshold {lossy} for the lossy mode, {clear} for the clear");
+    // Below it, no more than the faint wobble of the force's start.
+    let quiet = rms(tail(&rub_modes(&[(660.0, 3.0, 0.1)], 0.2, 0.005, 6.0), 0.5));
+    assert!(quiet < 1e-4, "below the threshold: {quiet}");
+}
+
+#[test]
+fn of_two_modes_rubbed_the_clearer_one_sings() {
+    // Equal gains: the mode that loses less takes the friction's energy.
+    for (clear_hz, lossy_hz) in [(520.0, 780.0), (780.0, 520.0)] {
+        let x = rub_modes(&[(clear_hz, 0.3, 0.05), (lossy_hz, 6.0, 0.05)], 0.2, 0.6, 4.0);
+        let hz = zero_crossing_hz(tail(&x, 1.0));
+        assert!(
+            (1200.0 * (hz / clear_hz).log2()).abs() < 5.0,
+            "sings at {hz:.1} Hz, not the clearer mode's {clear_hz} Hz"
+        );
+    }
+}
+
+#[test]
+fn a_rub_is_silent_on_bad_inputs_and_never_blows_up() {
+    for (speed, force) in [(f32::NAN, 0.5), (0.3, f32::INFINITY), (-1.0, 0.5), (1e9, 1e9)] {
+        let x = rub_modes(&[(440.0, 0.5, 0.01), (3000.0, 0.1, 10.0)], speed, force, 1.0);
+        assert!(x.iter().all(|v| v.is_finite() && v.abs() < 100.0), "{speed} {force}");
+    }
+}

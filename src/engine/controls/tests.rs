@@ -85,4 +85,9 @@ fn banks_name_exactly_the_engines_exciters() {
     use crate::dsp::ExciterKind;
     use crate::model::validate::EXCITER_NAMES;
     assert_eq!(EXCITER_NAMES, ExciterKind::ALL.map(|k| k.name()));
+    // The schema offers the same names.
+    let schema: serde_json::Value =
+        serde_json::from_str(&crate::model::schema::bank_schema_json()).unwrap();
+    let offered = schema["$defs"]["BankDefaults"]["properties"]["exciter"]["enum"].clone();
+    assert_eq!(offered, serde_json::json!(EXCITER_NAMES), "schema: {offered}");
 }
