@@ -307,12 +307,21 @@ fn a_rubbed_glass_sings_at_its_clearest_mode_while_held_and_rings_on_after() {
         20.0 * b.log10()
     );
     assert!(cents.abs() < 5.0, "sings at {hz:.2} Hz");
-    assert!((20.0 * (b / a).log10()).abs() < 0.5, "not steady: {a} then {b}");
+    assert!(
+        (20.0 * (b / a).log10()).abs() < 0.5,
+        "not steady: {a} then {b}"
+    );
     // Let go, it rings on at its own decay (0.4 /s: -1.7 dB in 0.5 s) and dies away.
     let (after, later) = (rms(span(&x, 4.2, 4.7)), rms(span(&x, 5.2, 5.7)));
-    assert!(after > 0.5 * b && after < b, "after release {after} against {b}");
+    assert!(
+        after > 0.5 * b && after < b,
+        "after release {after} against {b}"
+    );
     let db = 20.0 * (later / after).log10();
-    assert!((-5.5..-2.0).contains(&db), "rings on {db:.1} dB a second later");
+    assert!(
+        (-5.5..-2.0).contains(&db),
+        "rings on {db:.1} dB a second later"
+    );
     // Click-free: the song grows from nothing, and letting go leaves no step larger than the
     // song's own (1 % for the stick-slip's jitter).
     let steady = max_step(held);

@@ -114,7 +114,7 @@ pub const RUB_DC_HZ: f64 = 5.0;
 /// The object's velocity at the contact point, m/s, per unit of the modes' summed velocity
 /// (the state the resonators hold for a unit impulse): a rub's steady oscillation swings the
 /// contact point at about the rubbing speed, so this sets its level.
-const RUB_M_PER_S_PER_UNIT: f32 = 2.0;
+const RUB_M_PER_S_PER_UNIT: f32 = 1.0;
 
 /// How an object touches the surface.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -329,13 +329,7 @@ impl Contact {
     /// modes' velocities with the sign of their gains, and `gain_sum`, the sum of their gains'
     /// magnitudes (how far that velocity moves for a unit force in one sample).
     #[inline]
-    pub fn rub(
-        &mut self,
-        speed_m_per_s: f32,
-        force: f32,
-        velocity: f32,
-        gain_sum: f32,
-    ) -> f32 {
+    pub fn rub(&mut self, speed_m_per_s: f32, force: f32, velocity: f32, gain_sum: f32) -> f32 {
         let (target_speed, target_force) = targets(speed_m_per_s, force);
         let target_speed = target_speed.min(RUB_MAX_SPEED_M_PER_S);
         let k = self.smoothing;

@@ -80,9 +80,7 @@ impl ExciterKind {
         match self {
             ExciterKind::Impulse => Some(PulseShape::Impulse),
             ExciterKind::Mallet => Some(PulseShape::Mallet),
-            ExciterKind::Noise | ExciterKind::Scrape | ExciterKind::Roll | ExciterKind::Rub => {
-                None
-            }
+            ExciterKind::Noise | ExciterKind::Scrape | ExciterKind::Roll | ExciterKind::Rub => None,
         }
     }
 
@@ -317,7 +315,10 @@ impl Exciter {
                     }
                 }
                 // Contacts strike as mallets.
-                ExciterKind::Mallet | ExciterKind::Scrape | ExciterKind::Roll | ExciterKind::Rub => {
+                ExciterKind::Mallet
+                | ExciterKind::Scrape
+                | ExciterKind::Roll
+                | ExciterKind::Rub => {
                     if p.len == 1 {
                         out[0] += p.amplitude;
                     } else {

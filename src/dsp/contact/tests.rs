@@ -220,14 +220,23 @@ fn rub_modes(modes: &[(f64, f64, f32)], speed: f32, force: f32, seconds: f64) ->
     use crate::dsp::resonator_bank::ResonatorBank;
     let mut bank = ResonatorBank::new(modes.len());
     for (k, &(freq_hz, decay_per_s, gain)) in modes.iter().enumerate() {
-        bank.activate(k, ModeCoeffs::from_freq_decay(RATE, freq_hz, decay_per_s), gain);
+        bank.activate(
+            k,
+            ModeCoeffs::from_freq_decay(RATE, freq_hz, decay_per_s),
+            gain,
+        );
     }
     let mut c = Contact::new(ContactKind::Rub, 0.5, 7, RATE);
     let zeros = [0.0f32; 64];
     let mut out = Vec::new();
     for _ in 0..(seconds * RATE / 64.0) as usize {
         let mut acc = [[0.0f32; COLUMNS]; 64];
-        bank.process_rubbed(Kernel::detect(), &zeros, |v, g| c.rub(speed, force, v, g), &mut acc);
+        bank.process_rubbed(
+            Kernel::detect(),
+            &zeros,
+            |v, g| c.rub(speed, force, v, g),
+            &mut acc,
+        );
         out.extend(acc.iter().map(|a| a.iter().sum::<f32>()));
     }
     out
@@ -281,7 +290,12 @@ fn below_a_force_threshold_a_rubbed_mode_stays_silent_and_a_lossier_one_needs_mo
     let threshold = |decay_per_s: f64| {
         let sings: Vec<bool> = forces
             .iter()
-            .map(|&f| rms(tail(&rub_modes(&[(660.0, decay_per_s, 0.1)], 0.2, f, 6.0), 0.5)) > 0.01)
+            .map(|&f| {
+                rms(tail(
+                    &rub_modes(&[(660.0, decay_per_s, 0.1)], 0.2, f, 6.0),
+                    0.5,
+                )) > 0.01
+            })
             .collect();
         println!("decay {decay_per_s} /s: {sings:?}");
         // Silent below, singing from the threshold up.
@@ -291,7 +305,10 @@ fn below_a_force_threshold_a_rubbed_mode_stays_silent_and_a_lossier_one_needs_mo
         forces[first]
     };
     let (clear, lossy) = (threshold(0.3), threshold(3.0));
-    assert!(lossy > clear, "threshold {lossy} for the lossy mode, {clear} for the clear");
+    assert!(
+        lossy > clear,
+        "threshold {lossy} for the lossy mode, {clear} for the clear"
+    );
     // Below it, no more than the faint wobble of the force's start.
     let quiet = rms(tail(&rub_modes(&[(660.0, 3.0, 0.1)], 0.2, 0.005, 6.0), 0.5));
     assert!(quiet < 1e-4, "below the threshold: {quiet}");
@@ -301,7 +318,12 @@ fn below_a_force_threshold_a_rubbed_mode_stays_silent_and_a_lossier_one_needs_mo
 fn of_two_modes_rubbed_the_clearer_one_sings() {
     // Equal gains: the mode that loses less takes the friction's energy.
     for (clear_hz, lossy_hz) in [(520.0, 780.0), (780.0, 520.0)] {
-        let x = rub_modes(&[(clear_hz, 0.3, 0.05), (lossy_hz, 6.0, 0.05)], 0.2, 0.6, 4.0);
+        let x = rub_modes(
+            &[(clear_hz, 0.3, 0.05), (lossy_hz, 6.0, 0.05)],
+            0.2,
+            0.6,
+            4.0,
+        );
         let hz = zero_crossing_hz(tail(&x, 1.0));
         assert!(
             (1200.0 * (hz / clear_hz).log2()).abs() < 5.0,
@@ -312,8 +334,21 @@ fn of_two_modes_rubbed_the_clearer_one_sings() {
 
 #[test]
 fn a_rub_is_silent_on_bad_inputs_and_never_blows_up() {
-    for (speed, force) in [(f32::NAN, 0.5), (0.3, f32::INFINITY), (-1.0, 0.5), (1e9, 1e9)] {
-        let x = rub_modes(&[(440.0, 0.5, 0.01), (3000.0, 0.1, 10.0)], speed, force, 1.0);
-        assert!(x.iter().all(|v| v.is_finite() && v.abs() < 100.0), "{speed} {force}");
+    for (speed, force) in [
+        (f32::NAN, 0.5),
+        (0.3, f32::INFINITY),
+        (-1.0, 0.5),
+        (1e9, 1e9),
+    ] {
+        let x = rub_modes(
+            &[(440.0, 0.5, 0.01), (3000.0, 0.1, 10.0)],
+            speed,
+            force,
+            1.0,
+        );
+        assert!(
+            x.iter().all(|v| v.is_finite() && v.abs() < 100.0),
+            "{speed} {force}"
+        );
     }
 }

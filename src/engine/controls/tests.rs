@@ -89,5 +89,9 @@ fn banks_name_exactly_the_engines_exciters() {
     let schema: serde_json::Value =
         serde_json::from_str(&crate::model::schema::bank_schema_json()).unwrap();
     let offered = schema["$defs"]["BankDefaults"]["properties"]["exciter"]["enum"].clone();
-    assert_eq!(offered, serde_json::json!(EXCITER_NAMES), "schema: {offered}");
+    assert_eq!(
+        offered,
+        serde_json::json!(EXCITER_NAMES),
+        "schema: {offered}"
+    );
 }

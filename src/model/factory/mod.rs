@@ -46,6 +46,7 @@ mod key {
     pub const E2: u8 = 40;
     pub const F2: u8 = 41;
     pub const A2: u8 = 45;
+    pub const A3: u8 = 57;
     pub const D3: u8 = 50;
     pub const F3: u8 = 53;
     pub const C4: u8 = 60;
@@ -92,7 +93,7 @@ struct Tweaks {
 /// A contact a factory bank is played with: `defaults.exciter` and the contact's settings.
 #[derive(Debug, Clone, Copy)]
 struct Contact {
-    /// `scrape` or `roll`.
+    /// `scrape`, `roll` or `rub`.
     exciter: &'static str,
     /// Roughness, 0 to 1.
     roughness: f64,

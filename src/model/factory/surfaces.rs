@@ -1,9 +1,9 @@
-//! Factory banks of membranes, plates, discs and bells.
+//! Factory banks of membranes, plates, discs, bells and bowls.
 
 use super::{key, Contact, FactoryObject, Tweaks};
 use crate::model::materials;
 use crate::model::shapes::{
-    CircularMembrane, CircularPlate, PlateEdge, RectangularMembrane, RectangularPlate, Shape,
+    Bowl, CircularMembrane, CircularPlate, PlateEdge, RectangularMembrane, RectangularPlate, Shape,
     TunedBell,
 };
 
@@ -145,6 +145,54 @@ pub(super) fn objects() -> Vec<FactoryObject> {
                     roughness: 0.5,
                     rolling_radius_mm: Some(25.0),
                     speed_m_per_s: 0.6,
+                    force: 0.8,
+                }),
+                ..Tweaks::NONE
+            },
+        },
+        FactoryObject {
+            name: "Rubbed wine glass",
+            description: "A thin wine glass rubbed round its rim with a wet finger for as long \
+                          as a key is held: a pure, hovering tone that swells from nothing once \
+                          the finger grips, on the glass's lowest mode. Press too lightly or \
+                          move too fast and it will not sing; it rings on when let go. Velocity \
+                          and pressure set how hard the finger presses, slide or the mod wheel \
+                          its speed. The glass's stem is not modelled.",
+            shape: Shape::Bowl(Bowl {
+                diameter_m: 0.075,
+                thickness_m: 0.0012,
+            }),
+            material: &materials::GLASS,
+            root_key: key::E5,
+            tweaks: Tweaks {
+                contact: Some(Contact {
+                    exciter: "rub",
+                    roughness: 0.5,
+                    rolling_radius_mm: None,
+                    speed_m_per_s: 0.25,
+                    force: 0.7,
+                }),
+                ..Tweaks::NONE
+            },
+        },
+        FactoryObject {
+            name: "Singing bowl (circled with a stick)",
+            description: "A bronze singing bowl circled at its rim with a wooden stick for as \
+                          long as a key is held: a low hum that builds over a second or two, \
+                          beating slowly as the bowl's pairs of modes drift in and out of \
+                          step, and rings on for many seconds when the stick leaves it.",
+            shape: Shape::Bowl(Bowl {
+                diameter_m: 0.2,
+                thickness_m: 0.004,
+            }),
+            material: &materials::BRONZE,
+            root_key: key::A3,
+            tweaks: Tweaks {
+                contact: Some(Contact {
+                    exciter: "rub",
+                    roughness: 0.5,
+                    rolling_radius_mm: None,
+                    speed_m_per_s: 0.3,
                     force: 0.8,
                 }),
                 ..Tweaks::NONE

@@ -1,5 +1,5 @@
 //! Analytic shapes: the closed-form modes of strings, bars (free and clamped), membranes and
-//! plates (rectangular and circular) and bells, and the banks built from them (seed 000
+//! plates (rectangular and circular), bells and bowls, and the banks built from them (seed 000
 //! section 3.1).
 //!
 //! Each object yields, for every mode, a frequency, and the value of its mode shape `Psi_n` at
@@ -16,6 +16,7 @@
 pub mod bar;
 pub mod bell;
 pub mod bessel;
+pub mod bowl;
 pub mod cantilever;
 pub mod circular_plate;
 pub mod design;
@@ -32,6 +33,7 @@ pub mod string;
 
 pub use bar::{Bar, TunedBar, MARIMBA_RATIOS, VIBRAPHONE_RATIOS, XYLOPHONE_RATIOS};
 pub use bell::{BellPartial, TunedBell, TUNED_BELL_PARTIALS};
+pub use bowl::Bowl;
 pub use circular_plate::{CircularPlate, PlateEdge};
 pub use design::{design_bank, BankDesign};
 pub use membrane::CircularMembrane;

@@ -3,8 +3,8 @@
 //! a name and named dimensions into a [`Shape`].
 
 use super::{
-    Bar, CircularMembrane, CircularPlate, PlateEdge, RectangularMembrane, RectangularPlate, Shape,
-    ShapeError, StretchedString, TunedBar, TunedBell, MARIMBA_RATIOS, VIBRAPHONE_RATIOS,
+    Bar, Bowl, CircularMembrane, CircularPlate, PlateEdge, RectangularMembrane, RectangularPlate,
+    Shape, ShapeError, StretchedString, TunedBar, TunedBell, MARIMBA_RATIOS, VIBRAPHONE_RATIOS,
     XYLOPHONE_RATIOS,
 };
 use crate::model::materials::{self, Material};
@@ -21,7 +21,7 @@ pub enum Dimension {
     Thickness,
     /// Radius in m.
     Radius,
-    /// Diameter in m (of a wire, of a bell's mouth).
+    /// Diameter in m (of a wire, of a bell's mouth, of a bowl's rim).
     Diameter,
     /// Tension: N for a string, N/m for a membrane.
     Tension,
@@ -154,6 +154,15 @@ pub const OBJECTS: &[ObjectKind] = &[
         dimensions: &[
             (Dimension::Diameter, "m", 0.6),
             (Dimension::Thickness, "m", 0.046),
+        ],
+        default_material: &materials::BRONZE,
+    },
+    ObjectKind {
+        name: "bowl",
+        about: "open bowl or glass rung at its rim: singing bowl, wine glass, cup",
+        dimensions: &[
+            (Dimension::Diameter, "m", 0.2),
+            (Dimension::Thickness, "m", 0.004),
         ],
         default_material: &materials::BRONZE,
     },
@@ -309,6 +318,10 @@ impl ObjectSpec {
                 edge: self.edge.unwrap_or(PlateEdge::Free),
             }),
             "bell" => Shape::Bell(TunedBell {
+                diameter_m: v(Dimension::Diameter),
+                thickness_m: v(Dimension::Thickness),
+            }),
+            "bowl" => Shape::Bowl(Bowl {
                 diameter_m: v(Dimension::Diameter),
                 thickness_m: v(Dimension::Thickness),
             }),

@@ -3,7 +3,7 @@
 
 use super::positions::{line_coords, plane_coords};
 use super::{
-    cantilever, finish_modes, Bar, CircularMembrane, CircularPlate, ModeLimits,
+    cantilever, finish_modes, Bar, Bowl, CircularMembrane, CircularPlate, ModeLimits,
     RectangularMembrane, RectangularPlate, ShapeError, StretchedString, TunedBar, TunedBell,
 };
 use crate::model::materials::Material;
@@ -37,6 +37,8 @@ pub enum Shape {
     CircularPlate(CircularPlate),
     /// A tuned church bell. Positions: along the profile, 0 at the crown, 1 at the lip.
     Bell(TunedBell),
+    /// An open bowl or glass. Positions: along the wall, 0 at the base, 1 at the rim.
+    Bowl(Bowl),
 }
 
 impl Shape {
@@ -53,6 +55,7 @@ impl Shape {
             Self::RectangularPlate(_) => "rectangular-plate",
             Self::CircularPlate(_) => "circular-plate",
             Self::Bell(_) => "bell",
+            Self::Bowl(_) => "bowl",
         }
     }
 
@@ -79,6 +82,7 @@ impl Shape {
             Self::RectangularPlate(plate) => plate.validate(),
             Self::CircularPlate(plate) => plate.validate(),
             Self::Bell(bell) => bell.validate(),
+            Self::Bowl(bowl) => bowl.validate(),
         }
     }
 
@@ -112,6 +116,7 @@ impl Shape {
                 check_thin("thickness_m", p.thickness_m, 2.0 * p.radius_m, "diameter")
             }
             Self::Bell(b) => check_thin("thickness_m", b.thickness_m, b.diameter_m, "diameter"),
+            Self::Bowl(b) => check_thin("thickness_m", b.thickness_m, b.diameter_m, "diameter"),
         }
     }
 
@@ -129,6 +134,7 @@ impl Shape {
             Self::RectangularPlate(plate) => plate.fundamental_hz(material),
             Self::CircularPlate(plate) => plate.fundamental_hz(material),
             Self::Bell(bell) => bell.prime_hz(material),
+            Self::Bowl(bowl) => bowl.fundamental_hz(material),
         }
     }
 
@@ -160,6 +166,7 @@ impl Shape {
             }
             Self::CircularPlate(plate) => Self::CircularPlate(plate.tuned_to(material, root_hz)),
             Self::Bell(bell) => Self::Bell(bell.tuned_to(material, root_hz)),
+            Self::Bowl(bowl) => Self::Bowl(bowl.tuned_to(material, root_hz)),
         })
     }
 
@@ -198,6 +205,7 @@ impl Shape {
                 plate.shaped_modes(material, &plane_coords(positions, true)?, limits)
             }
             Self::Bell(bell) => bell.shaped_modes(material, &line_coords(positions)?, limits),
+            Self::Bowl(bowl) => bowl.shaped_modes(material, &line_coords(positions)?, limits),
         };
         finish_modes(shaped, material, limits)
     }

@@ -2,7 +2,7 @@
 //! mallet, its dimensions and parameters by name, and a one-line summary.
 
 use super::positions::position;
-use super::{bell, CircularPlate, PlateEdge, Shape, TunedBar, TUNED_BELL_PARTIALS};
+use super::{bell, bowl, CircularPlate, PlateEdge, Shape, TunedBar, TUNED_BELL_PARTIALS};
 use crate::model::materials::{Material, MaterialClass};
 use crate::model::Position;
 use serde_json::{json, Map, Value};
@@ -47,6 +47,7 @@ impl Shape {
                 ..
             }) => "clamped circular plate",
             Self::Bell(_) => "tuned bell",
+            Self::Bowl(_) => "bowl",
         }
     }
 
@@ -96,6 +97,12 @@ impl Shape {
                 position("sound bow", &[bell::SOUND_BOW]),
                 position("lip", &[1.0]),
             ],
+            Self::Bowl(_) => vec![
+                position("low on the wall", &[0.4]),
+                position("middle of the wall", &[0.65]),
+                position("below the rim", &[0.85]),
+                position("rim", &[bowl::RIM]),
+            ],
         }
     }
 
@@ -110,6 +117,7 @@ impl Shape {
             Self::CircularMembrane(_) | Self::CircularPlate(_) => vec![0.67, 0.0],
             Self::RectangularPlate(_) | Self::RectangularMembrane(_) => vec![0.38, 0.42],
             Self::Bell(_) => vec![bell::SOUND_BOW],
+            Self::Bowl(_) => vec![bowl::RIM],
         }
     }
 
@@ -156,6 +164,10 @@ impl Shape {
                 ("diameter", bell.diameter_m),
                 ("thickness", bell.thickness_m),
             ],
+            Self::Bowl(bowl) => vec![
+                ("diameter", bowl.diameter_m),
+                ("thickness", bowl.thickness_m),
+            ],
         };
         pairs
             .into_iter()
@@ -189,6 +201,10 @@ impl Shape {
             Self::Bell(_) => {
                 let ratios: Vec<f64> = TUNED_BELL_PARTIALS.iter().map(|p| p.ratio).collect();
                 map.insert("partial_ratios".into(), json!(ratios));
+            }
+            Self::Bowl(_) => {
+                map.insert("doublet_split".into(), json!(bowl::DOUBLET_SPLIT));
+                map.insert("strike_angle_rad".into(), json!(bowl::STRIKE_ANGLE_RAD));
             }
             Self::FreeFreeBar(_) | Self::ClampedFreeBar(_) | Self::RectangularPlate(_) => {}
         }
@@ -240,6 +256,11 @@ impl Shape {
             ),
             Self::Bell(b) => format!(
                 "{} mm across, sound bow {} mm thick",
+                mm(b.diameter_m),
+                mm(b.thickness_m)
+            ),
+            Self::Bowl(b) => format!(
+                "{} mm across the rim, wall {} mm thick",
                 mm(b.diameter_m),
                 mm(b.thickness_m)
             ),
