@@ -26,7 +26,7 @@ const KEYS: std::ops::Range<u8> = 24..40;
 fn engine_realtime_factor(bank: &Bank, seconds: f64) -> f64 {
     let mut engine = Engine::new(Arc::new(PreparedBank::new(bank)));
     engine.prepare(RATE_HZ, BLOCK);
-    let mut controls = ModalParams::new(false).controls(0.0, 0.0, 0.0);
+    let mut controls = ModalParams::new(false).controls();
     controls.truncation_db = -140.0;
     engine.set_controls(&controls);
     let notes: Vec<NoteEvent> = KEYS.map(|key| NoteEvent::on(0, key, 1.0)).collect();

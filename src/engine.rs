@@ -17,6 +17,8 @@
 
 mod budget;
 mod controls;
+mod expression;
+mod midi;
 mod mix;
 mod position;
 mod prepared;
@@ -29,9 +31,12 @@ use std::sync::Arc;
 pub use controls::{
     control_range, ControlSpec, Controls, Material, ANALYSIS_FRAME_RANGE_MS,
     CONTACT_SPEED_MAX_M_PER_S, HARDNESS_RANGE_MS, MASKING_OFFSET_RANGE_DB, MATERIAL_Q_RANGE,
-    MAX_MODE_BUDGET, MAX_POLYPHONY, MAX_TARGET_LOAD_PCT, NUMERIC_CONTROLS,
-    PLAYBACK_LEVEL_RANGE_DB_SPL, VARIATION_CENTS, VARIATION_DECAY, VARIATION_GAIN_DB,
+    MAX_MODE_BUDGET, MAX_POLYPHONY, MAX_TARGET_LOAD_PCT, MPE_DEFAULT_BEND_RANGE_SEMITONES,
+    NUMERIC_CONTROLS, PLAYBACK_LEVEL_RANGE_DB_SPL, VARIATION_CENTS, VARIATION_DECAY,
+    VARIATION_GAIN_DB,
 };
+pub use expression::{ControlChange, Controllers, ExpressionTarget};
+pub use midi::{bend_of, MidiInput, MidiMessage, CHANNELS, MPE_MANAGER_CHANNEL, SLIDE_CC};
 pub use mix::{
     mix_to_mono, Bypass, DryWet, FadeOut, OnsetTrigger, BANK_CROSSFADE_S, BYPASS_FADE_S,
 };
@@ -170,6 +175,9 @@ pub enum NoteEvent {
         id: i32,
         modulation: VoiceModulation,
     },
+    /// A channel-wide controller moves (pitch bend, mod wheel, channel pressure): the controls
+    /// follow it from this sample ([`Controls::expressed`]).
+    Controller { time: u32, change: ControlChange },
 }
 
 /// A per-note change.
@@ -198,6 +206,10 @@ pub enum VoiceModulation {
     StrikeY(f32),
     /// Mallet contact time in milliseconds.
     HardnessMs(f32),
+    /// Contact speed in m/s (while no slide sets it).
+    ContactSpeed(f32),
+    /// Contact force at full velocity, 0 to 1 (until the note's own pressure sets it).
+    ContactForce(f32),
 }
 
 impl VoiceModulation {
@@ -209,6 +221,8 @@ impl VoiceModulation {
             VoiceModulation::StrikeX(v) => ("strike_x", v),
             VoiceModulation::StrikeY(v) => ("strike_y", v),
             VoiceModulation::HardnessMs(v) => ("hardness_ms", v),
+            VoiceModulation::ContactSpeed(v) => ("contact_speed_m_per_s", v),
+            VoiceModulation::ContactForce(v) => ("contact_force", v),
         };
         if value.is_nan() {
             return None;
@@ -221,6 +235,8 @@ impl VoiceModulation {
             VoiceModulation::StrikeX(_) => VoiceModulation::StrikeX(v),
             VoiceModulation::StrikeY(_) => VoiceModulation::StrikeY(v),
             VoiceModulation::HardnessMs(_) => VoiceModulation::HardnessMs(v),
+            VoiceModulation::ContactSpeed(_) => VoiceModulation::ContactSpeed(v),
+            VoiceModulation::ContactForce(_) => VoiceModulation::ContactForce(v),
         })
     }
 }
@@ -262,7 +278,8 @@ impl NoteEvent {
             | NoteEvent::Choke { time, .. }
             | NoteEvent::Expression { time, .. }
             | NoteEvent::ChannelExpression { time, .. }
-            | NoteEvent::Modulate { time, .. } => time,
+            | NoteEvent::Modulate { time, .. }
+            | NoteEvent::Controller { time, .. } => time,
         }
     }
 
@@ -276,7 +293,8 @@ impl NoteEvent {
             | NoteEvent::Choke { time, .. }
             | NoteEvent::Expression { time, .. }
             | NoteEvent::ChannelExpression { time, .. }
-            | NoteEvent::Modulate { time, .. } => *time = at,
+            | NoteEvent::Modulate { time, .. }
+            | NoteEvent::Controller { time, .. } => *time = at,
         }
         self
     }
@@ -335,8 +353,12 @@ struct Smoothed {
 pub struct Engine {
     /// The bank being played.
     bank: Arc<PreparedBank>,
-    /// Control targets, sanitised.
+    /// Control targets as set, sanitised.
     controls: Controls,
+    /// Where the channel-wide controllers are.
+    controllers: Controllers,
+    /// Control targets as the controllers move them: what plays.
+    expressed: Controls,
     /// Resonator implementation.
     kernel: Kernel,
     /// Sample rate in Hz.
@@ -407,6 +429,8 @@ impl Engine {
         };
         Self {
             bank,
+            expressed: controls.clone(),
+            controllers: Controllers::default(),
             controls,
             kernel: Kernel::from_env_or_detect(),
             sample_rate_hz: 48_000.0,
@@ -532,10 +556,10 @@ impl Engine {
         self.smoothed = Smoothed {
             log_damping,
             tilt,
-            gain: db_to_gain(self.controls.output_gain_db),
-            input_gain: db_to_gain(self.controls.input_gain_db),
-            weights: lane_weights(self.controls.width, &self.bank.column_pan),
-            weight_target: lane_weights(self.controls.width, &self.bank.column_pan),
+            gain: db_to_gain(self.expressed.output_gain_db),
+            input_gain: db_to_gain(self.expressed.input_gain_db),
+            weights: lane_weights(self.expressed.width, &self.bank.column_pan),
+            weight_target: lane_weights(self.expressed.width, &self.bank.column_pan),
             weight_step: ([0.0; COLUMNS], [0.0; COLUMNS]),
             weight_ramp_left: 0,
         };
@@ -548,16 +572,36 @@ impl Engine {
         &self.bank
     }
 
-    /// The control targets.
+    /// The control targets as set (before the controllers move them).
     pub fn controls(&self) -> &Controls {
         &self.controls
     }
 
     /// Sets the control targets (sanitised: out-of-range values are clamped, NaN takes the
-    /// default). Changes are smoothed from the next control tick. Does not allocate.
+    /// default), which the channel-wide controllers then move. Changes are smoothed from the
+    /// next control tick. Does not allocate.
     pub fn set_controls(&mut self, controls: &Controls) {
-        self.controls.clone_from(controls);
-        self.controls = self.controls.sanitized();
+        self.controls = controls.sanitized();
+        self.expressed = self.controls.expressed(&self.controllers).sanitized();
+    }
+
+    /// Where the channel-wide controllers are.
+    pub fn controllers(&self) -> Controllers {
+        self.controllers
+    }
+
+    /// Puts the channel-wide controllers where `controllers` has them (an engine taking over
+    /// from another, where the player left the wheels).
+    pub fn set_controllers(&mut self, controllers: Controllers) {
+        self.controllers = Controllers::default();
+        for change in [
+            ControlChange::Bend(controllers.bend),
+            ControlChange::ModWheel(controllers.mod_wheel),
+            ControlChange::Pressure(controllers.pressure),
+        ] {
+            self.controllers.apply(change);
+        }
+        self.expressed = self.controls.expressed(&self.controllers).sanitized();
     }
 
     /// The resonator implementation in use.

@@ -9,8 +9,7 @@ use nice_plug::prelude::*;
 
 use crate::dsp::ExciterKind;
 use crate::engine::{
-    control_range, Controls, Material, VoiceModulation, CONTACT_SPEED_MAX_M_PER_S,
-    MATERIAL_Q_RANGE, MAX_POLYPHONY,
+    control_range, Controls, Material, VoiceModulation, MATERIAL_Q_RANGE, MAX_POLYPHONY,
 };
 use crate::model::factory::{factory_bank, DEFAULT_FACTORY_BANK};
 
@@ -30,13 +29,17 @@ pub mod poly_id {
     pub const STRIKE_Y: u32 = 3;
     /// Hardness.
     pub const HARDNESS: u32 = 4;
+    /// Contact speed.
+    pub const CONTACT_SPEED: u32 = 5;
+    /// Contact force.
+    pub const CONTACT_FORCE: u32 = 6;
     /// How many there are.
-    pub const COUNT: usize = 5;
+    pub const COUNT: usize = 7;
 }
 
 /// Default per-note pitch-bend range of MPE member channels, in semitones (the MPE
 /// specification's default).
-pub const MPE_DEFAULT_BEND_RANGE: f32 = 48.0;
+pub const MPE_DEFAULT_BEND_RANGE: f32 = crate::engine::MPE_DEFAULT_BEND_RANGE_SEMITONES;
 
 /// Version of the plugin state's own fields; raised when they change meaning.
 pub const STATE_FORMAT: u32 = 2;
@@ -147,6 +150,20 @@ pub enum ExpressionTarget {
     #[id = "force"]
     #[name = "Contact force"]
     Force,
+}
+
+impl ExpressionTarget {
+    /// The engine's target.
+    pub fn target(self) -> crate::engine::ExpressionTarget {
+        use crate::engine::ExpressionTarget as T;
+        match self {
+            ExpressionTarget::None => T::None,
+            ExpressionTarget::Position => T::Position,
+            ExpressionTarget::Damping => T::Damping,
+            ExpressionTarget::Speed => T::Speed,
+            ExpressionTarget::Force => T::Force,
+        }
+    }
 }
 
 /// The bank in use, saved in the plugin state as its JSON text, so a project reopens with the
@@ -479,8 +496,10 @@ impl ModalParams {
                     -1.0,
                 )
                 .with_unit(" m/s")
-                .with_step_size(0.01),
-                contact_force: percent("Contact force", d.contact_force),
+                .with_step_size(0.01)
+                .with_poly_modulation_id(poly_id::CONTACT_SPEED),
+                contact_force: percent("Contact force", d.contact_force)
+                    .with_poly_modulation_id(poly_id::CONTACT_FORCE),
             },
             material: MaterialParams {
                 material: EnumParam::new("Material", MaterialChoice::Authored),
@@ -574,6 +593,8 @@ impl ModalParams {
             poly_id::STRIKE_X => &self.strike.strike_x,
             poly_id::STRIKE_Y => &self.strike.strike_y,
             poly_id::HARDNESS => &self.strike.hardness,
+            poly_id::CONTACT_SPEED => &self.strike.contact_speed,
+            poly_id::CONTACT_FORCE => &self.strike.contact_force,
             _ => return None,
         })
     }
@@ -594,6 +615,8 @@ impl ModalParams {
             poly_id::SIZE => VoiceModulation::SizeRatio(value),
             poly_id::STRIKE_X => VoiceModulation::StrikeX(value),
             poly_id::STRIKE_Y => VoiceModulation::StrikeY(value),
+            poly_id::CONTACT_SPEED => VoiceModulation::ContactSpeed(value),
+            poly_id::CONTACT_FORCE => VoiceModulation::ContactForce(value),
             _ => VoiceModulation::HardnessMs(value),
         })
     }
@@ -603,9 +626,9 @@ impl ModalParams {
         self.voices.polyphony.value().clamp(1, MAX_POLYPHONY as i32) as usize
     }
 
-    /// The engine controls for the current values, with the channel's expression: pitch bend
-    /// (-1 to 1), mod wheel and pressure (0 to 1).
-    pub fn controls(&self, bend: f32, mod_wheel: f32, pressure: f32) -> Controls {
+    /// The engine controls for the current values (which the engine's channel-wide controllers
+    /// then move: [`Controls::expressed`]).
+    pub fn controls(&self) -> Controls {
         let (material_q, damping_tilt) = match self.material.material.value() {
             MaterialChoice::Authored => (None, self.material.damping_tilt.value()),
             MaterialChoice::Custom => (
@@ -624,45 +647,32 @@ impl ModalParams {
             MaterialChoice::Glass => (Some(Material::Glass.q()), Material::Glass.damping_tilt()),
             MaterialChoice::Metal => (Some(Material::Metal.q()), Material::Metal.damping_tilt()),
         };
-        let mut strike_x = self.strike.strike_x.value();
-        let mut extra_damping = 0.0;
-        let mut contact_speed_m_per_s = self.strike.contact_speed.value();
-        let mut contact_force = self.strike.contact_force.value();
-        for (target, amount) in [
-            (self.voices.mod_wheel_target.value(), mod_wheel),
-            (self.voices.pressure_target.value(), pressure),
-        ] {
-            match target {
-                ExpressionTarget::None => {}
-                ExpressionTarget::Position => strike_x += amount * (1.0 - strike_x),
-                ExpressionTarget::Damping => extra_damping += amount,
-                ExpressionTarget::Speed => {
-                    contact_speed_m_per_s = amount * CONTACT_SPEED_MAX_M_PER_S
-                }
-                ExpressionTarget::Force => contact_force = amount,
-            }
-        }
         Controls {
             material_q,
             damping_tilt,
             size_ratio: self.object.size.value(),
             key_tracking: self.object.key_tracking.value(),
             fine_tune_cents: self.object.fine_tune.value(),
-            pitch_bend_semitones: bend * self.object.bend_range.value(),
-            strike_x,
+            pitch_bend_semitones: 0.0,
+            bend_range_semitones: self.object.bend_range.value(),
+            mod_wheel_target: self.voices.mod_wheel_target.value().target(),
+            pressure_target: self.voices.pressure_target.value().target(),
+            mpe: self.voices.mpe.value(),
+            mpe_bend_range_semitones: self.voices.mpe_bend_range.value(),
+            strike_x: self.strike.strike_x.value(),
             strike_y: self.strike.strike_y.value(),
             position_variation: self.strike.position_variation.value(),
             strike_variation: self.strike.strike_variation.value(),
             exciter: self.strike.exciter.value().kind(),
             roughness: self.strike.roughness.value(),
             rolling_radius_mm: self.strike.rolling_radius.value(),
-            contact_speed_m_per_s,
-            contact_force,
+            contact_speed_m_per_s: self.strike.contact_speed.value(),
+            contact_force: self.strike.contact_force.value(),
             hardness_ms: self.strike.hardness.value(),
             velocity_sensitivity: self.strike.velocity_sensitivity.value(),
             velocity_to_hardness: self.strike.velocity_to_hardness.value(),
             release_damping: self.material.release_damping.value(),
-            extra_damping: extra_damping.min(1.0),
+            extra_damping: 0.0,
             truncation_db: self.voices.truncation.value(),
             polyphony: self.polyphony(),
             width: self.output.width.value(),

@@ -2,7 +2,9 @@
 //!
 //! [`render`] drives one [`Engine`] exactly as a plugin host would: fixed blocks, note events at
 //! their exact sample inside a block, nothing else. The same notes and settings give the same
-//! samples bit for bit, whatever the block size.
+//! samples bit for bit, whatever the block size. A MIDI file's messages are read by the engine's
+//! own MIDI reading ([`MidiInput`]), the plugins': a MIDI file rendered here and the same MIDI
+//! played to a plugin at the same samples give the same samples.
 
 mod midi_file;
 mod notes;
@@ -12,13 +14,13 @@ use std::fmt;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-pub use midi_file::read_midi_file;
+pub use midi_file::{read_midi_file, TimedMidi};
 pub use notes::{parse_notes, Note};
 pub use wav::{to_int_sample, wav_bytes, write_wav, BitDepth, WavFile};
 
 use crate::dsp::ExciterKind;
 use crate::engine::{
-    Controls, Engine, NoteEvent, NoteExpression, PositionMap, PreparedBank,
+    Controls, Engine, MidiInput, MidiMessage, NoteEvent, NoteExpression, PositionMap, PreparedBank,
     CONTACT_SPEED_MAX_M_PER_S,
 };
 use crate::model::Bank;
@@ -198,6 +200,94 @@ struct TimedEvent {
     event: NoteEvent,
 }
 
+/// What a render plays: notes (from `--notes`, with their contact curves), or a MIDI file's
+/// messages.
+#[derive(Debug, Clone, Copy)]
+pub enum Score<'a> {
+    /// Notes, in any order.
+    Notes(&'a [Note]),
+    /// MIDI messages, in time order.
+    Midi(&'a [TimedMidi]),
+}
+
+impl<'a> From<&'a [Note]> for Score<'a> {
+    fn from(notes: &'a [Note]) -> Self {
+        Score::Notes(notes)
+    }
+}
+
+impl<'a> From<&'a Vec<Note>> for Score<'a> {
+    fn from(notes: &'a Vec<Note>) -> Self {
+        Score::Notes(notes)
+    }
+}
+
+impl<'a, const N: usize> From<&'a [Note; N]> for Score<'a> {
+    fn from(notes: &'a [Note; N]) -> Self {
+        Score::Notes(notes)
+    }
+}
+
+impl<'a> From<&'a Vec<TimedMidi>> for Score<'a> {
+    fn from(midi: &'a Vec<TimedMidi>) -> Self {
+        Score::Midi(midi)
+    }
+}
+
+impl<'a> From<&'a [TimedMidi]> for Score<'a> {
+    fn from(midi: &'a [TimedMidi]) -> Self {
+        Score::Midi(midi)
+    }
+}
+
+impl Score<'_> {
+    /// The time of the first note struck at or after `seconds`, and its number from 1, if any.
+    pub fn first_note_from(&self, seconds: f64) -> Option<(usize, f64)> {
+        match self {
+            Score::Notes(notes) => notes
+                .iter()
+                .enumerate()
+                .find(|(_, n)| n.time_s >= seconds)
+                .map(|(i, n)| (i + 1, n.time_s)),
+            Score::Midi(midi) => midi
+                .iter()
+                .filter(
+                    |m| matches!(m.message, MidiMessage::NoteOn { velocity, .. } if velocity > 0.0),
+                )
+                .enumerate()
+                .find(|(_, m)| m.time_s >= seconds)
+                .map(|(i, m)| (i + 1, m.time_s)),
+        }
+    }
+
+    /// The engine events at `rate` up to `until_s`, in the order the engine must see them.
+    fn schedule(&self, rate: f64, until_s: f64, controls: &Controls) -> Vec<TimedEvent> {
+        match self {
+            Score::Notes(notes) => schedule(notes, rate, until_s),
+            Score::Midi(midi) => schedule_midi(midi, rate, controls),
+        }
+    }
+}
+
+/// The engine events of MIDI `messages` at `rate`, as a plugin reads them with `controls`.
+fn schedule_midi(messages: &[TimedMidi], rate: f64, controls: &Controls) -> Vec<TimedEvent> {
+    let mut input = MidiInput::default();
+    let mut events = Vec::with_capacity(messages.len());
+    for m in messages {
+        let sample = (m.time_s * rate).round().max(0.0) as u64;
+        input.read(0, m.message, controls, |event| {
+            events.push(TimedEvent {
+                sample,
+                rank: 1,
+                event,
+            })
+        });
+    }
+    // Stable: messages on one sample keep their order.
+    events.sort_by_key(|e| e.sample);
+    events
+}
+
 /// The events of `notes` at `rate`, in the order the engine must see them.
 fn schedule(notes: &[Note], rate: f64, until_s: f64) -> Vec<TimedEvent> {
     let to_sample = |t: f64| (t * rate).round().max(0.0) as u64;
@@ -357,11 +447,10 @@ pub fn resynthesize(bank: &Bank, position: usize, sample_rate_hz: u32, len: usiz
     out
 }
 
-/// Renders `notes` (in any order) through `bank` with `settings` into memory, as
-/// [`render_to`] renders them.
-pub fn render(
+/// Renders `score` through `bank` with `settings` into memory, as [`render_to`] renders it.
+pub fn render<'a>(
     bank: &Arc<PreparedBank>,
-    notes: &[Note],
+    score: impl Into<Score<'a>>,
     settings: &RenderSettings,
     progress: impl FnMut(f64),
 ) -> Rendered {
@@ -372,7 +461,7 @@ pub fn render(
         right.extend_from_slice(r);
         Ok::<(), std::convert::Infallible>(())
     };
-    let Ok(summary) = render_to(bank, notes, settings, 1.0, progress, sink);
+    let Ok(summary) = render_to(bank, score, settings, 1.0, progress, sink);
     Rendered {
         left,
         right,
@@ -382,7 +471,7 @@ pub fn render(
     }
 }
 
-/// Renders `notes` (in any order) through `bank` with `settings`, every sample multiplied by
+/// Renders `score` through `bank` with `settings`, every sample multiplied by
 /// `scale`, handing the stereo samples to `sink` in order as they are made (in pieces of any
 /// length, left and right of equal length) and calling `progress` with the fraction done (0 to
 /// 1, an estimate until the end) after each block. Memory does not grow with the length: only
@@ -396,9 +485,9 @@ pub fn render(
 ///
 /// # Panics
 /// If the sample rate is below 8000 Hz.
-pub fn render_to<E>(
+pub fn render_to<'a, E>(
     bank: &Arc<PreparedBank>,
-    notes: &[Note],
+    score: impl Into<Score<'a>>,
     settings: &RenderSettings,
     scale: f32,
     mut progress: impl FnMut(f64),
@@ -412,7 +501,9 @@ pub fn render_to<E>(
     engine.reserve_voices(settings.controls.polyphony);
     engine.prepare(settings.sample_rate_hz as f32, block);
 
-    let mut events = schedule(notes, rate, settings.max_seconds);
+    let mut events = score
+        .into()
+        .schedule(rate, settings.max_seconds, &settings.controls);
     // A release past the end changes nothing that is not still sounding at the cut; a strike
     // past it is a note not played.
     let dropped = events

@@ -1206,3 +1206,106 @@ fn the_pruning_parameters_reach_the_engine() {
         "the playback level changed nothing (largest difference {diff}, peak {scale})"
     );
 }
+
+/// Samples per tick of the MIDI file below: 480 ticks a quarter at 120 bpm is 960 a second.
+const SAMPLES_PER_TICK: usize = 50;
+
+/// The MIDI a player sends with bends, pressure, slide, the wheel and the pedal: (sample,
+/// bytes); a two-byte message carries a 0 third byte.
+const GESTURES: [(usize, [u8; 3]); 13] = [
+    (2_400, [0x90, 60, 100]),
+    (4_800, [0xE0, 0x00, 0x60]),
+    (6_000, [0x90, 67, 80]),
+    (7_200, [0xB0, 74, 90]),
+    (9_600, [0xD0, 80, 0]),
+    (12_000, [0xB0, 1, 64]),
+    (14_400, [0xA0, 60, 100]),
+    (16_800, [0xB0, 64, 127]),
+    (19_200, [0x80, 60, 0]),
+    (20_000, [0xE0, 0x7F, 0x7F]),
+    (21_600, [0x90, 64, 90]),
+    (22_800, [0x80, 67, 0]),
+    (24_000, [0xB0, 64, 0]),
+];
+
+/// `GESTURES` as a standard MIDI file.
+fn gestures_file(path: &std::path::Path) {
+    use midly::num::{u15, u28};
+    use midly::{live::LiveEvent, Format, Header, Smf, Timing, TrackEvent, TrackEventKind};
+    let mut track = Vec::new();
+    let mut last = 0;
+    for &(sample, bytes) in &GESTURES {
+        assert_eq!(sample % SAMPLES_PER_TICK, 0);
+        let tick = sample / SAMPLES_PER_TICK;
+        let len = if bytes[0] & 0xF0 == 0xD0 { 2 } else { 3 };
+        let LiveEvent::Midi { channel, message } = LiveEvent::parse(&bytes[..len]).unwrap() else {
+            panic!("not a channel message");
+        };
+        track.push(TrackEvent {
+            delta: u28::new((tick - last) as u32),
+            kind: TrackEventKind::Midi { channel, message },
+        });
+        last = tick;
+    }
+    track.push(TrackEvent {
+        delta: u28::new(0),
+        kind: TrackEventKind::Meta(midly::MetaMessage::EndOfTrack),
+    });
+    Smf {
+        header: Header::new(Format::SingleTrack, Timing::Metrical(u15::new(480))),
+        tracks: vec![track],
+    }
+    .save(path)
+    .unwrap();
+}
+
+#[test]
+fn a_midi_file_rendered_offline_equals_the_plugin_playing_it() {
+    use modal_resonator::dsp::ExciterKind;
+    use modal_resonator::engine::PreparedBank;
+    use modal_resonator::params::ModalParams;
+    use modal_resonator::render::{read_midi_file, render, RenderSettings};
+    use std::sync::Arc;
+
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("gestures.mid");
+    gestures_file(&path);
+    let messages = read_midi_file(&path).unwrap();
+    let bank = two_position_bank();
+    let state = state_with(&bank);
+    let samples = 36_000;
+    // Struck (pressure damps, the wheel moves the strike), and scraped (pressure is the force,
+    // slide the speed).
+    for (exciter, index) in [(ExciterKind::Mallet, 0.0), (ExciterKind::Scrape, 3.0)] {
+        let mut events: Vec<(usize, Send)> = vec![(0, Send::Param("exc", index))];
+        events.extend(GESTURES.iter().map(|&(at, bytes)| (at, Send::Midi(bytes))));
+        let played = run(&Script {
+            state: Some(&state),
+            events: &events,
+            ..Script::new(INSTRUMENT, samples)
+        });
+        let mut controls = ModalParams::new(false).controls();
+        controls.exciter = exciter;
+        let settings = RenderSettings {
+            controls,
+            max_seconds: samples as f64 / RATE,
+            block: BLOCK,
+            ..RenderSettings::default()
+        };
+        let rendered = render(
+            &Arc::new(PreparedBank::new(&bank)),
+            &messages,
+            &settings,
+            |_| {},
+        );
+        // The render fades its last 10 ms out when cut while sounding.
+        let n = samples - 480;
+        assert!(peak(&played.left[2_400..n]) > 0.01, "{exciter:?}: silent");
+        let first_difference = (0..n)
+            .find(|&i| played.left[i] != rendered.left[i] || played.right[i] != rendered.right[i]);
+        assert_eq!(
+            first_difference, None,
+            "{exciter:?}: the plugin and the render part at sample {first_difference:?}"
+        );
+    }
+}

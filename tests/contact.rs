@@ -331,3 +331,44 @@ fn a_rubbed_glass_sings_at_its_clearest_mode_while_held_and_rings_on_after() {
         "steps {start} at the start, {stop} at the stop, {steady} held"
     );
 }
+
+#[test]
+fn polyphonic_modulation_sets_one_contact_notes_speed_and_force() {
+    use modal_resonator::engine::VoiceModulation;
+    let bank = dense_bank(300, 110.0);
+    let with_id = Note {
+        key: KEY,
+        channel: 0,
+        id: Some(7),
+    };
+    let held = |modulation: Option<VoiceModulation>| {
+        let mut e = contact_engine(&bank, ExciterKind::Scrape, 0.5);
+        let mut events = vec![NoteEvent::On {
+            time: 0,
+            note: with_id,
+            velocity: 1.0,
+        }];
+        if let Some(modulation) = modulation {
+            events.push(NoteEvent::Modulate {
+                time: 0,
+                id: 7,
+                modulation,
+            });
+        }
+        let x = play(&mut e, &events, 0.6);
+        span(&x, 0.3, 0.6).to_vec()
+    };
+    let plain = held(None);
+    // Half the force: 6 dB down.
+    let light = held(Some(VoiceModulation::ContactForce(0.35)));
+    let db = 20.0 * (rms(&light) / rms(&plain)).log10();
+    assert!((db + 6.0).abs() < 1.0, "half the force: {db:.1} dB");
+    // The note's own speed, whatever the control's (0.5 m/s): faster is brighter.
+    let slow = held(Some(VoiceModulation::ContactSpeed(0.1)));
+    let fast = held(Some(VoiceModulation::ContactSpeed(1.5)));
+    let (c_slow, c_fast) = (centroid_hz(&slow[..8192]), centroid_hz(&fast[..8192]));
+    assert!(
+        c_fast > 1.5 * c_slow,
+        "centroid {c_fast:.0} Hz against {c_slow:.0} Hz"
+    );
+}

@@ -9,7 +9,7 @@ use std::cell::Cell;
 use common::*;
 use modal_resonator::dsp::ExciterKind;
 use modal_resonator::engine::{
-    Controls, Note, NoteEvent, NoteExpression, VoiceModulation, NUMERIC_CONTROLS,
+    ControlChange, Controls, Note, NoteEvent, NoteExpression, VoiceModulation, NUMERIC_CONTROLS,
 };
 
 struct Counting;
@@ -100,10 +100,21 @@ fn process_never_allocates() {
                     };
                     match i % 8 {
                         4 => NoteEvent::off(time, ((i * 13 + b) % 128) as u8),
-                        5 => NoteEvent::Modulate {
+                        5 if b % 2 == 0 => NoteEvent::Modulate {
                             time,
                             id: (i as i32) - 5,
-                            modulation: VoiceModulation::FineTuneCents(b as f32 - 100.0),
+                            modulation: match b % 4 {
+                                0 => VoiceModulation::FineTuneCents(b as f32 - 100.0),
+                                _ => VoiceModulation::ContactForce((b % 5) as f32 / 4.0),
+                            },
+                        },
+                        5 => NoteEvent::Controller {
+                            time,
+                            change: match b % 3 {
+                                0 => ControlChange::Bend((b % 7) as f32 / 3.0 - 1.0),
+                                1 => ControlChange::ModWheel((b % 5) as f32 / 4.0),
+                                _ => ControlChange::Pressure((b % 9) as f32 / 8.0),
+                            },
                         },
                         6 => NoteEvent::ChannelExpression {
                             time,

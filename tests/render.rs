@@ -10,7 +10,7 @@ use midly::{
     Format, Fps, Header, MetaMessage, MidiMessage, Smf, Timing, TrackEvent, TrackEventKind,
 };
 
-use modal_resonator::engine::PreparedBank;
+use modal_resonator::engine::{MidiMessage as EngineMidi, PreparedBank};
 use modal_resonator::model::Bank;
 use modal_resonator::render::{
     parse_notes, read_midi_file, render, to_int_sample, write_wav, BitDepth, Note, RenderSettings,
@@ -441,26 +441,35 @@ fn midi_files_follow_the_tempo_map_across_tracks() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("two-tempos.mid");
     write_two_tempo_file(&path);
-    let notes = read_midi_file(&path).unwrap();
+    let messages = read_midi_file(&path).unwrap();
+    // (time, channel, key, velocity; 0 for a release).
     let expected = [
-        (69, 100, 0.5, Some(0.25)),
-        (64, 64, 1.25, Some(0.125)),
-        (72, 127, 1.5, None),
+        (0.5, 0, 69, 100),
+        (0.75, 0, 69, 0),
+        (1.25, 9, 64, 64),
+        (1.375, 9, 64, 0),
+        (1.5, 0, 72, 127),
     ];
-    assert_eq!(notes.len(), expected.len(), "{notes:?}");
-    for (i, (note, (key, vel, time_s, duration_s))) in notes.iter().zip(expected).enumerate() {
-        assert_eq!(note.key, key, "note {i}");
-        assert_eq!(note.velocity, vel as f32 / 127.0, "note {i}");
+    assert_eq!(messages.len(), expected.len(), "{messages:?}");
+    for (i, (m, (time_s, channel, key, vel))) in messages.iter().zip(expected).enumerate() {
         assert!(
-            (note.time_s - time_s).abs() < 1e-9,
-            "note {i}: time {} s, expected {time_s}",
-            note.time_s
+            (m.time_s - time_s).abs() < 1e-9,
+            "message {i}: time {} s, expected {time_s}",
+            m.time_s
         );
-        match (note.duration_s, duration_s) {
-            (Some(d), Some(e)) => {
-                assert!((d - e).abs() < 1e-9, "note {i}: duration {d}, expected {e}")
+        match m.message {
+            EngineMidi::NoteOn { note, velocity } => {
+                assert_eq!((note.channel, note.key), (channel, key), "message {i}");
+                assert_eq!(velocity, vel as f32 / 127.0, "message {i}");
             }
-            (d, e) => assert_eq!(d, e, "note {i}"),
+            EngineMidi::NoteOff { note } => {
+                assert_eq!(
+                    (note.channel, note.key, 0),
+                    (channel, key, vel),
+                    "message {i}"
+                )
+            }
+            other => panic!("message {i}: {other:?}"),
         }
     }
 }
@@ -485,6 +494,102 @@ fn midi_notes_render_on_their_samples() {
     }
 }
 
+fn midi(delta: u32, channel: u8, message: MidiMessage) -> TrackEvent<'static> {
+    event(
+        delta,
+        TrackEventKind::Midi {
+            channel: u4::new(channel),
+            message,
+        },
+    )
+}
+
+fn controller(delta: u32, cc: u8, value: u8) -> TrackEvent<'static> {
+    midi(
+        delta,
+        0,
+        MidiMessage::Controller {
+            controller: u7::new(cc),
+            value: u7::new(value),
+        },
+    )
+}
+
+/// A one-track file at 480 ticks per quarter and 120 bpm (a tick is 1/960 s).
+fn save_track(path: &Path, mut track: Vec<TrackEvent<'static>>) {
+    track.push(end_of_track());
+    let smf = Smf {
+        header: Header::new(Format::SingleTrack, Timing::Metrical(u15::new(480))),
+        tracks: vec![track],
+    };
+    smf.save(path).unwrap();
+}
+
+#[test]
+fn midi_files_bend_and_hold_notes_with_the_pedal() {
+    let dir = tempfile::tempdir().unwrap();
+    let bank = harmonic_bank(2.0);
+    // A note bent a whole tone up half a second in.
+    let path = dir.path().join("bend.mid");
+    save_track(
+        &path,
+        vec![
+            note_on(0, 0, 69, 127),
+            midi(
+                480,
+                0,
+                MidiMessage::PitchBend {
+                    bend: midly::PitchBend(midly::num::u14::new(16_383)),
+                },
+            ),
+            note_off(960, 0, 69),
+        ],
+    );
+    let messages = read_midi_file(&path).unwrap();
+    let r = render(&prepared(&bank), &messages, &settings(&bank), |_| {});
+    let before = common::pitch_hz(&r.left[2_400..21_600], RATE as f64, 300.0, 600.0);
+    let after = common::pitch_hz(&r.left[30_000..60_000], RATE as f64, 300.0, 600.0);
+    let whole_tone = 440.0 * 2f64.powf(2.0 / 12.0);
+    assert!(
+        (before / 440.0 - 1.0).abs() < 0.003,
+        "before the bend: {before} Hz"
+    );
+    assert!(
+        (after / whole_tone - 1.0).abs() < 0.003,
+        "after the bend: {after} Hz"
+    );
+
+    // Released notes damped at once, unless the pedal holds them: a note let go at 0.2 s under
+    // the pedal sounds on until the pedal lifts at 0.6 s.
+    let mut damped = settings(&bank);
+    damped.controls.release_damping = 1.0;
+    let path = dir.path().join("pedal.mid");
+    save_track(
+        &path,
+        vec![
+            note_on(0, 0, 69, 127),
+            controller(96, 64, 127),
+            note_off(96, 0, 69),
+            controller(384, 64, 0),
+        ],
+    );
+    let messages = read_midi_file(&path).unwrap();
+    let r = render(&prepared(&bank), &messages, &damped, |_| {});
+    let level = |from_s: f64, to_s: f64| {
+        let (a, b) = (
+            (from_s * RATE as f64) as usize,
+            (to_s * RATE as f64) as usize,
+        );
+        common::peak(&r.left[a..b.min(r.len())])
+    };
+    let (held, lifted) = (level(0.5, 0.6), level(0.75, 0.85));
+    assert!(held > 0.1 * level(0.0, 0.1), "held by the pedal: {held}");
+    assert!(
+        lifted < 0.01 * held,
+        "after the pedal lifts: {lifted} against {held}"
+    );
+}
+
 #[test]
 fn smpte_timecode_files_count_ticks_per_second() {
     let dir = tempfile::tempdir().unwrap();
@@ -500,13 +605,13 @@ fn smpte_timecode_files_count_ticks_per_second() {
         ]],
     };
     smf.save(&path).unwrap();
-    let notes = read_midi_file(&path).unwrap();
-    assert_eq!(notes.len(), 1);
-    assert!((notes[0].time_s - 0.5).abs() < 1e-9, "{:?}", notes[0]);
+    let messages = read_midi_file(&path).unwrap();
+    assert_eq!(messages.len(), 2);
+    assert!((messages[0].time_s - 0.5).abs() < 1e-9, "{:?}", messages[0]);
     assert!(
-        (notes[0].duration_s.unwrap() - 0.25).abs() < 1e-9,
+        (messages[1].time_s - 0.75).abs() < 1e-9,
         "{:?}",
-        notes[0]
+        messages[1]
     );
 }
 
@@ -530,11 +635,11 @@ fn a_midi_file_cut_short_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let whole = dir.path().join("whole.mid");
     write_two_tempo_file(&whole);
-    assert_eq!(read_midi_file(&whole).unwrap().len(), 3);
+    assert_eq!(read_midi_file(&whole).unwrap().len(), 5);
     let bytes = std::fs::read(&whole).unwrap();
     let padded = dir.path().join("padded.mid");
     std::fs::write(&padded, [&bytes[..], &[0, 0, 0]].concat()).unwrap();
-    assert_eq!(read_midi_file(&padded).unwrap().len(), 3);
+    assert_eq!(read_midi_file(&padded).unwrap().len(), 5);
     let mut riff = b"RIFF".to_vec();
     riff.extend_from_slice(&(4 + 8 + bytes.len() as u32).to_le_bytes());
     riff.extend_from_slice(b"RMIDdata");
@@ -542,7 +647,7 @@ fn a_midi_file_cut_short_is_refused() {
     riff.extend_from_slice(&bytes);
     let rmid = dir.path().join("wrapped.rmi");
     std::fs::write(&rmid, &riff).unwrap();
-    assert_eq!(read_midi_file(&rmid).unwrap().len(), 3);
+    assert_eq!(read_midi_file(&rmid).unwrap().len(), 5);
     let cut_rmid = dir.path().join("cut-wrapped.rmi");
     std::fs::write(&cut_rmid, &riff[..riff.len() - 3]).unwrap();
     let err = read_midi_file(&cut_rmid).unwrap_err().to_string();

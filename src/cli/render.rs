@@ -11,7 +11,7 @@ use clap::Args;
 use modal_resonator::engine::{Controls, PositionMap, PreparedBank};
 use modal_resonator::render::{
     parse_notes, read_midi_file, render_to, wav_bytes, BitDepth, Note, RenderSettings, Rendered,
-    WavFile,
+    Score, TimedMidi, WavFile,
 };
 
 use super::progress::Progress;
@@ -81,16 +81,22 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
             );
         }
     }
-    let notes: Vec<Note> = match (&args.notes, &args.midi) {
-        (Some(text), _) => parse_notes(text).map_err(|e| format!("--notes: {e}"))?,
-        (None, Some(path)) => read_midi_file(path).map_err(|e| e.to_string())?,
+    let (notes, midi): (Vec<Note>, Vec<TimedMidi>) = match (&args.notes, &args.midi) {
+        (Some(text), _) => (
+            parse_notes(text).map_err(|e| format!("--notes: {e}"))?,
+            Vec::new(),
+        ),
+        (None, Some(path)) => (Vec::new(), read_midi_file(path).map_err(|e| e.to_string())?),
         (None, None) => unreachable!("clap requires --notes or --midi"),
     };
-    if let Some(late) = notes.iter().position(|n| n.time_s >= args.max_seconds) {
+    let score = if args.notes.is_some() {
+        Score::Notes(&notes)
+    } else {
+        Score::Midi(&midi)
+    };
+    if let Some((number, time_s)) = score.first_note_from(args.max_seconds) {
         return Err(format!(
-            "note {} starts at {} s, at or after --max-seconds {}",
-            late + 1,
-            notes[late].time_s,
+            "note {number} starts at {time_s} s, at or after --max-seconds {}",
             args.max_seconds
         ));
     }
@@ -124,7 +130,7 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
             let quiet = |_: &[f32], _: &[f32]| Ok::<(), Infallible>(());
             let Ok(first) = render_to(
                 &bank,
-                &notes,
+                score,
                 &settings,
                 1.0,
                 |d| progress.set(0.5 * d),
@@ -150,7 +156,7 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
         };
         let Ok(rendered) = render_to(
             &bank,
-            &notes,
+            score,
             &settings,
             scale,
             |d| progress.set(share(d)),
@@ -177,7 +183,7 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
             WavFile::create(&args.output, args.bits, args.rate).map_err(|e| e.to_string())?;
         let rendered = render_to(
             &bank,
-            &notes,
+            score,
             &settings,
             scale,
             |d| progress.set(share(d)),

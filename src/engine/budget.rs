@@ -146,6 +146,6 @@ impl Engine {
 
     /// The cap on computed modes the controls ask for now, if any.
     pub fn mode_cap(&self) -> Option<usize> {
-        self.budget.cap(&self.controls, self.sample_rate_hz)
+        self.budget.cap(&self.expressed, self.sample_rate_hz)
     }
 }

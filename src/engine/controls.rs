@@ -3,6 +3,7 @@
 
 mod by_name;
 
+use super::expression::ExpressionTarget;
 use super::position::PositionMap;
 use crate::dsp::ExciterKind;
 use crate::model::validate::{
@@ -95,8 +96,20 @@ pub struct Controls {
     pub key_tracking: f32,
     /// Fine tuning in cents.
     pub fine_tune_cents: f32,
-    /// Current pitch bend in semitones (the plugin scales the wheel by its bend range).
+    /// Pitch bend in semitones, besides the wheel's (which moves it by up to
+    /// `bend_range_semitones` either way).
     pub pitch_bend_semitones: f32,
+    /// How far the pitch-bend wheel bends, in semitones either way.
+    pub bend_range_semitones: f32,
+    /// What the mod wheel moves.
+    pub mod_wheel_target: ExpressionTarget,
+    /// What channel pressure moves.
+    pub pressure_target: ExpressionTarget,
+    /// MPE (lower zone): the bend, pressure and slide of member channels 2 to 16 are their
+    /// notes' own.
+    pub mpe: bool,
+    /// How far an MPE member channel's bend bends its note, in semitones either way.
+    pub mpe_bend_range_semitones: f32,
     /// Strike position along the bank's positions, 0 to 1 (first axis of 2-D banks).
     pub strike_x: f32,
     /// Strike position on the second axis of 2-D banks, 0 to 1.
@@ -165,6 +178,11 @@ impl Default for Controls {
             key_tracking: 1.0,
             fine_tune_cents: 0.0,
             pitch_bend_semitones: 0.0,
+            bend_range_semitones: 2.0,
+            mod_wheel_target: ExpressionTarget::Position,
+            pressure_target: ExpressionTarget::Damping,
+            mpe: false,
+            mpe_bend_range_semitones: MPE_DEFAULT_BEND_RANGE_SEMITONES,
             strike_x: 0.0,
             strike_y: 0.0,
             position_variation: 0.0,
@@ -249,6 +267,29 @@ pub const NUMERIC_CONTROLS: &[ControlSpec] = &[
         48.0,
         pitch_bend_semitones
     ),
+    spec!(
+        "bend_range_semitones",
+        "st",
+        0.0,
+        48.0,
+        bend_range_semitones
+    ),
+    spec!(
+        "mpe_bend_range_semitones",
+        "st",
+        0.0,
+        96.0,
+        mpe_bend_range_semitones
+    ),
+    ControlSpec {
+        name: "mpe",
+        unit: "",
+        min: 0.0,
+        max: 1.0,
+        integer: true,
+        get: |c| c.mpe as u8 as f32,
+        set: |c, v| c.mpe = v >= 0.5,
+    },
     spec!("strike_x", "", 0.0, 1.0, strike_x),
     spec!("strike_y", "", 0.0, 1.0, strike_y),
     spec!("position_variation", "", 0.0, 1.0, position_variation),
@@ -364,6 +405,9 @@ pub fn control_range(name: &str) -> (f32, f32) {
         .unwrap_or_else(|| panic!("no numeric control named {name}"));
     (spec.min, spec.max)
 }
+
+/// An MPE member channel's bend range by default, in semitones (the MPE specification's).
+pub const MPE_DEFAULT_BEND_RANGE_SEMITONES: f32 = 48.0;
 
 /// Most a strike's pitch moves at full strike variation, in cents (either way).
 pub const VARIATION_CENTS: f32 = 5.0;

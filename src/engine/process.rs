@@ -64,10 +64,10 @@ impl Engine {
 
     /// Natural logs of the decay multiplier and the tilt the controls ask for.
     pub(super) fn damping_targets(&self) -> (f64, f64) {
-        let extra = self.controls.extra_damping as f64 * MAX_EXTRA_DAMPING.ln();
+        let extra = self.expressed.extra_damping as f64 * MAX_EXTRA_DAMPING.ln();
         (
-            self.bank.log_damping(self.controls.material_q) + extra,
-            self.controls.damping_tilt as f64,
+            self.bank.log_damping(self.expressed.material_q) + extra,
+            self.expressed.damping_tilt as f64,
         )
     }
 
@@ -82,9 +82,9 @@ impl Engine {
         }
         s.log_damping = log_damping;
         s.tilt = tilt;
-        s.gain = db_to_gain(self.controls.output_gain_db);
-        s.input_gain = db_to_gain(self.controls.input_gain_db);
-        s.weights = lane_weights(self.controls.width, &self.bank.column_pan);
+        s.gain = db_to_gain(self.expressed.output_gain_db);
+        s.input_gain = db_to_gain(self.expressed.input_gain_db);
+        s.weights = lane_weights(self.expressed.width, &self.bank.column_pan);
         s.weight_target = s.weights;
         s.weight_ramp_left = 0;
     }
@@ -114,7 +114,7 @@ impl Engine {
     /// Lowest decay rate of a released voice, in 1/s: release damping 1 gives a 50 ms T60,
     /// smaller values longer ones (200x longer towards 0), 0 none.
     fn release_decay(&self) -> f64 {
-        let r = self.controls.release_damping as f64;
+        let r = self.expressed.release_damping as f64;
         if r <= 0.0 {
             0.0
         } else {
@@ -149,7 +149,7 @@ impl Engine {
             }
         }
         // Stereo width: ramp the column weights over the next period.
-        let target = lane_weights(self.controls.width, &self.bank.column_pan);
+        let target = lane_weights(self.expressed.width, &self.bank.column_pan);
         if target != self.smoothed.weights && self.smoothed.weight_ramp_left == 0 {
             let inv = 1.0 / CONTROL_PERIOD as f32;
             for j in 0..COLUMNS {
@@ -160,7 +160,7 @@ impl Engine {
             self.smoothed.weight_ramp_left = CONTROL_PERIOD;
         }
 
-        let threshold = db_to_gain(self.controls.truncation_db);
+        let threshold = db_to_gain(self.expressed.truncation_db);
         let pitch_k = self.tick_coefficient(PITCH_SMOOTHING_S);
         let input_key = self
             .last_key
@@ -171,7 +171,7 @@ impl Engine {
         let num_voices = self.voices.len();
         let no_overrides = VoiceOverrides::default();
         let (controls, bank, decay, rate, ended, time) = (
-            &self.controls,
+            &self.expressed,
             &self.bank,
             &self.decay,
             self.sample_rate_hz,
@@ -223,7 +223,7 @@ impl Engine {
             }
         }
         // Polyphony lowered: fade the quietest voices beyond the limit.
-        let polyphony = self.controls.polyphony.min(self.capacity);
+        let polyphony = self.expressed.polyphony.min(self.capacity);
         while self.voices.iter().filter(|v| v.is_sounding()).count() > polyphony {
             let victim = self.quietest_sounding();
             self.voices[victim].state = VoiceState::Fading;
@@ -297,6 +297,10 @@ impl Engine {
                 }
             }
             NoteEvent::AllSoundOff { .. } => self.end_all_voices(),
+            NoteEvent::Controller { change, .. } => {
+                self.controllers.apply(change);
+                self.expressed = self.controls.expressed(&self.controllers).sanitized();
+            }
         }
     }
 
@@ -339,7 +343,7 @@ impl Engine {
         {
             return i;
         }
-        let polyphony = self.controls.polyphony.min(self.capacity);
+        let polyphony = self.expressed.polyphony.min(self.capacity);
         if self.voices.iter().filter(|v| v.is_sounding()).count() >= polyphony {
             let victim = self.quietest_sounding();
             self.voices[victim].state = VoiceState::Fading;
@@ -412,7 +416,7 @@ impl Engine {
             self.rebuild_decay_table();
         }
         let release = self.release_decay();
-        let c = &self.controls;
+        let c = &self.expressed;
         let v = &mut self.voices[i];
         let o = v.overrides;
         // On a contact note pressure is the contact's force, not a hand damping the object.
@@ -425,7 +429,7 @@ impl Engine {
         }
         let tuning = tuning_of(v, self.damping_version, release);
 
-        let c = &self.controls;
+        let c = &self.expressed;
         let vary = c.position_variation;
         let (mut x, mut y) = (
             o.strike_x.unwrap_or(c.strike_x),
@@ -483,7 +487,7 @@ impl Engine {
     /// `amplitude`, its width from `hardness_ms`. A note released at the sample it started
     /// (a click on the strike pad, a note of no length) lets go of it at once.
     fn start_contact(&mut self, i: usize, kind: ExciterKind, amplitude: f32, hardness_ms: f32) {
-        let c = &self.controls;
+        let c = &self.expressed;
         let v = &mut self.voices[i];
         v.contact_velocity = amplitude;
         let (speed, force) = contact_targets(c, v);
@@ -527,7 +531,7 @@ impl Engine {
         self.drive_input_voice(input, n);
 
         let s = &mut self.smoothed;
-        let target_gain = db_to_gain(self.controls.output_gain_db);
+        let target_gain = db_to_gain(self.expressed.output_gain_db);
         let gain_k = (1.0 - (-1.0 / (GAIN_SMOOTHING_S * self.sample_rate_hz)).exp()) as f32;
         // Pairwise sums: independent adds, not a chain of eight (one per column).
         const _: () = assert!(COLUMNS == 8);
@@ -574,7 +578,7 @@ impl Engine {
             return;
         };
         // Smoothed per sample, so automation of the input gain does not zipper.
-        let target_gain = db_to_gain(self.controls.input_gain_db);
+        let target_gain = db_to_gain(self.expressed.input_gain_db);
         let gain_k = (1.0 - (-1.0 / (INPUT_GAIN_SMOOTHING_S * self.sample_rate_hz)).exp()) as f32;
         let gain = &mut self.smoothed.input_gain;
         let x = &mut self.excitation[..n];
@@ -595,7 +599,7 @@ impl Engine {
                     .last_key
                     .unwrap_or(self.bank.root_key.round().clamp(0.0, 127.0) as u8);
                 let target = target_log_pitch(
-                    &self.controls,
+                    &self.expressed,
                     self.bank.root_key,
                     key,
                     &VoiceOverrides::default(),
@@ -603,7 +607,7 @@ impl Engine {
                 let weights = self
                     .bank
                     .positions
-                    .weights(self.controls.strike_x, self.controls.strike_y);
+                    .weights(self.expressed.strike_x, self.expressed.strike_y);
                 self.bank.gains_at(&weights, &mut self.strike_gains);
                 let Some(v) = self.input_voice.as_mut() else {
                     return;
@@ -723,17 +727,20 @@ fn contact_shape(c: &Controls, kind: ExciterKind, hardness_ms: f32) -> ContactKi
     }
 }
 
-/// Where a contact note's speed (m/s) and force are going: the note's slide, else the contact
-/// speed; the note's own pressure once it has pressed, else the contact force (which the
-/// channel's pressure or mod wheel may set) times its velocity.
+/// Where a contact note's speed (m/s) and force are going: the note's slide, else its own
+/// contact speed (polyphonic modulation), else the contact speed; the note's own pressure once it
+/// has pressed, else its own or the engine's contact force (which the channel's pressure or mod
+/// wheel may set) times its velocity.
 fn contact_targets(c: &Controls, v: &Voice) -> (f32, f32) {
-    let speed = v
-        .slide
-        .map_or(c.contact_speed_m_per_s, |s| s * CONTACT_SPEED_MAX_M_PER_S);
+    let o = &v.overrides;
+    let speed = v.slide.map_or(
+        o.contact_speed_m_per_s.unwrap_or(c.contact_speed_m_per_s),
+        |s| s * CONTACT_SPEED_MAX_M_PER_S,
+    );
     let force = if v.pressed {
         v.pressure
     } else {
-        c.contact_force * v.contact_velocity
+        o.contact_force.unwrap_or(c.contact_force) * v.contact_velocity
     };
     (speed, force)
 }

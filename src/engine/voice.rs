@@ -44,6 +44,10 @@ pub struct VoiceOverrides {
     pub strike_y: Option<f32>,
     /// Mallet contact time in milliseconds.
     pub hardness_ms: Option<f32>,
+    /// Contact speed in m/s.
+    pub contact_speed_m_per_s: Option<f32>,
+    /// Contact force at full velocity.
+    pub contact_force: Option<f32>,
 }
 
 /// A strike waiting for the other events at its sample.
@@ -194,6 +198,8 @@ impl Voice {
             VoiceModulation::StrikeX(v) => o.strike_x = Some(v),
             VoiceModulation::StrikeY(v) => o.strike_y = Some(v),
             VoiceModulation::HardnessMs(v) => o.hardness_ms = Some(v),
+            VoiceModulation::ContactSpeed(v) => o.contact_speed_m_per_s = Some(v),
+            VoiceModulation::ContactForce(v) => o.contact_force = Some(v),
         }
     }
 

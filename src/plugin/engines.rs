@@ -158,6 +158,10 @@ impl Engines {
             let old = if wanted {
                 let mut engine = loaded.engine;
                 engine.set_last_key(last_key);
+                // The wheels are where the player left them.
+                if let Some(current) = self.current.as_ref() {
+                    engine.set_controllers(current.controllers());
+                }
                 self.playing_generation = loaded.generation;
                 match self.current.replace(engine) {
                     Some(old) if !old.is_silent() => {

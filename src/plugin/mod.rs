@@ -23,13 +23,12 @@ pub use kind::{Effect, Instrument, Kind};
 use crate::dsp::denormal::flush_subnormals;
 use crate::editor::{self, EditorApp, EditorLinks, EditorShared, AUDITION_NOTE_ID};
 use crate::engine::{
-    mix_to_mono, Bypass, DryWet, EndedVoice, NoteEvent as EngineEvent, OnsetTrigger, PositionMap,
-    MAX_POLYPHONY,
+    mix_to_mono, Bypass, Controls, DryWet, EndedVoice, MidiInput, NoteEvent as EngineEvent,
+    OnsetTrigger, PositionMap, MAX_POLYPHONY,
 };
 use crate::model::factory::bank_from_state;
 use crate::params::{InputMode, ModalParams, STATE_FORMAT, STATE_FORMAT_FIELD};
 use engines::Engines;
-use events::{ControlChange, Expression};
 use poly::PolyTable;
 
 /// Set by a standalone with no display: its plugin then offers no editor, so the standalone
@@ -98,8 +97,9 @@ pub struct ModalPlugin<K: Kind> {
     events: Vec<EngineEvent>,
     /// Note events of the part of the block being rendered, timed from its start.
     segment_events: Vec<EngineEvent>,
-    /// Channel-wide controller changes of the current block, in time order.
-    changes: Vec<(u32, ControlChange)>,
+    /// The channel-wide controller events of the part of the block being rendered, for the
+    /// outgoing engine.
+    outgoing_events: Vec<EngineEvent>,
     /// The host's polyphonic modulation offsets, per note id.
     poly: PolyTable,
     /// Output of the outgoing engine.
@@ -110,8 +110,10 @@ pub struct ModalPlugin<K: Kind> {
     dry: [Vec<f32>; 2],
     /// Strikes at the input's onsets in trigger mode.
     onsets: OnsetTrigger,
-    /// Where the player's controllers are.
-    expression: Expression,
+    /// The MIDI being played: channels' controllers, pedals, sustained notes.
+    midi: MidiInput,
+    /// The controls MIDI is read with this block.
+    midi_controls: Controls,
     /// Last key struck, if any: the pitch of onsets (else the bank's root).
     last_key: Option<u8>,
     /// The dry/wet mix, ramped from segment to segment.
@@ -137,13 +139,14 @@ impl<K: Kind> Default for ModalPlugin<K> {
             background,
             events: Vec::with_capacity(MAX_EVENTS),
             segment_events: Vec::with_capacity(MAX_EVENTS),
-            changes: Vec::with_capacity(MAX_EVENTS),
+            outgoing_events: Vec::with_capacity(MAX_EVENTS),
             poly: PolyTable::new(POLY_NOTES),
             outgoing_out: [Vec::new(), Vec::new()],
             input: Vec::new(),
             dry: [Vec::new(), Vec::new()],
             onsets: OnsetTrigger::new(48_000.0),
-            expression: Expression::default(),
+            midi: MidiInput::default(),
+            midi_controls: Controls::default(),
             last_key: None,
             dry_wet: DryWet::default(),
             bypass: Bypass::default(),
@@ -224,8 +227,7 @@ impl<K: Kind> ModalPlugin<K> {
         }
         let drive = (have_input && mode == InputMode::Direct).then_some(&self.input[..n]);
 
-        let e = &self.expression;
-        let controls = self.params.controls(e.bend, e.mod_wheel, e.pressure);
+        let controls = self.params.controls();
         let (left, rest) = channels.split_at_mut(1);
         let (out_l, out_r) = (&mut left[0][start..end], &mut rest[0][start..end]);
         let Some(engine) = self.engines.current.as_mut() else {
@@ -242,7 +244,15 @@ impl<K: Kind> ModalPlugin<K> {
             let [ol, or] = &mut self.outgoing_out;
             let (ol, or) = (&mut ol[..n], &mut or[..n]);
             outgoing.engine.set_controls(&controls);
-            outgoing.engine.process(&[], drive, ol, or);
+            self.outgoing_events.clear();
+            self.outgoing_events.extend(
+                self.segment_events
+                    .iter()
+                    .filter(|e| matches!(e, EngineEvent::Controller { .. })),
+            );
+            outgoing
+                .engine
+                .process(&self.outgoing_events, drive, ol, or);
             let rate = outgoing.engine.sample_rate_hz();
             outgoing.fade.add([out_l, out_r], [ol, or], rate);
             // Nothing to tell the host: its notes were reported ended at the swap.
@@ -451,8 +461,10 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         self.engines.drop_outgoing();
         self.poly.clear();
         self.last_key = None;
-        // Pitch bend, mod wheel and pressure are where the player left them: a host resets
-        // the plugin on every start of processing, and the wheel has not moved.
+        self.midi.forget_notes();
+        // Pitch bend, mod wheel and pressure are where the player left them (the engine keeps
+        // them through a reset): a host resets the plugin on every start of processing, and
+        // the wheel has not moved.
     }
 
     fn process(
@@ -490,23 +502,11 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         }
         let exciter = aux.inputs.first().map(|b| b.as_slice_immutable());
 
-        // Render in segments: one ends where a channel-wide controller moves (so bends and
-        // wheels act from their sample, to the engine's control grid) and none is longer than
-        // the buffers sized for the announced maximum block.
+        // Render in segments no longer than the buffers sized for the announced maximum block.
         let max_segment = self.input.len();
-        let (mut start, mut next_event, mut next_change) = (0, 0, 0);
+        let (mut start, mut next_event) = (0, 0);
         while start < n {
-            while let Some(&(time, change)) = self.changes.get(next_change) {
-                if time as usize > start {
-                    break;
-                }
-                self.expression.apply(change);
-                next_change += 1;
-            }
-            let mut end = (start + max_segment).min(n);
-            if let Some(&(time, _)) = self.changes.get(next_change) {
-                end = end.min(time as usize);
-            }
+            let end = (start + max_segment).min(n);
             self.segment_events.clear();
             while let Some(event) = self.events.get(next_event) {
                 let time = event.time() as usize;
@@ -525,11 +525,6 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         for channel in channels.iter_mut() {
             flush_subnormals(&mut channel[..n]);
         }
-        // Controllers timed past the block's end (hosts should not send them) act now.
-        for &(_, change) in &self.changes[next_change..] {
-            self.expression.apply(change);
-        }
-
         // Modulation of notes that no longer sound (their end lost, or never started) is
         // forgotten.
         if let Some(engine) = self.engines.current.as_ref() {

@@ -1,26 +1,40 @@
-//! Standard MIDI files read into notes in seconds.
+//! Standard MIDI files read into timed MIDI messages, in seconds.
 //!
-//! Every track and channel is merged into one list. Metrical files follow the tempo map (set-tempo
-//! meta events from any track, 120 bpm until the first); SMPTE timecode files count fixed ticks per
-//! second. A note-on with velocity 0 is a note-off; each note-off ends the earliest note still held
-//! on its channel and key. Only notes are read: controllers, pitch bend and program changes are
-//! ignored.
+//! Every track and channel is merged into one list, in time order (messages at one tick keep their
+//! track order). Metrical files follow the tempo map (set-tempo meta events from any track, 120 bpm
+//! until the first); SMPTE timecode files count fixed ticks per second. Notes, polyphonic and
+//! channel pressure, control changes and pitch bend are read, with values scaled as a plugin host
+//! scales them (7-bit values over 127, the 14-bit bend over 16383), so the renderer plays them
+//! exactly as the plugins do ([`crate::engine::MidiInput`]); program changes and system messages
+//! are left out.
 
-use std::collections::{HashMap, VecDeque};
 use std::path::Path;
 
-use midly::{MetaMessage, MidiMessage, Smf, Timing, TrackEventKind};
+use midly::{MetaMessage, MidiMessage as Wire, Smf, Timing, TrackEventKind};
 
-use super::{Note, RenderError};
+use super::RenderError;
+use crate::engine::{MidiMessage, Note};
+
+/// A MIDI message at a time in seconds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TimedMidi {
+    /// Seconds from the start.
+    pub time_s: f64,
+    /// The message.
+    pub message: MidiMessage,
+}
 
 /// Tempo until the first set-tempo event: 120 bpm, as the MIDI file specification says.
 const DEFAULT_MICROS_PER_QUARTER: u32 = 500_000;
 
-/// Largest MIDI velocity, which maps to velocity 1.
-const MAX_VELOCITY: f32 = 127.0;
+/// Largest 7-bit MIDI value, which maps to 1.
+const MAX_7_BIT: f32 = 127.0;
 
-/// Reads the notes of the MIDI file at `path`, sorted by time.
-pub fn read_midi_file(path: impl AsRef<Path>) -> Result<Vec<Note>, RenderError> {
+/// Largest 14-bit MIDI value (pitch bend), which maps to 1.
+const MAX_14_BIT: f32 = 16_383.0;
+
+/// Reads the messages of the MIDI file at `path`, sorted by time.
+pub fn read_midi_file(path: impl AsRef<Path>) -> Result<Vec<TimedMidi>, RenderError> {
     let path = path.as_ref();
     let bytes = std::fs::read(path).map_err(|source| RenderError::Io {
         path: path.to_path_buf(),
@@ -34,7 +48,7 @@ pub fn read_midi_file(path: impl AsRef<Path>) -> Result<Vec<Note>, RenderError> 
         path: path.to_path_buf(),
         message,
     })?;
-    Ok(notes_of(&smf))
+    Ok(messages_of(&smf))
 }
 
 /// An error unless every track a standard MIDI file declares is there whole: the parser reads
@@ -103,19 +117,54 @@ fn riff_data(bytes: &[u8]) -> Result<&[u8], String> {
     Err("the file is cut short: a RIFF file without its data chunk".to_string())
 }
 
-/// A note or tempo event at an absolute tick.
+/// A message or tempo change at an absolute tick.
 #[derive(Debug, Clone, Copy)]
 enum Event {
     /// Set-tempo meta event.
     Tempo { micros_per_quarter: u32 },
-    /// Note-on with a velocity above 0.
-    On { channel: u8, key: u8, velocity: u8 },
-    /// Note-off, or note-on with velocity 0.
-    Off { channel: u8, key: u8 },
+    /// A channel message.
+    Midi(MidiMessage),
 }
 
-/// The notes of a parsed file, sorted by time.
-fn notes_of(smf: &Smf) -> Vec<Note> {
+/// The engine's message for a channel message of the file; `None` for those it does not play.
+fn message_of(channel: u8, message: Wire) -> Option<MidiMessage> {
+    let note = |key: midly::num::u7| Note {
+        key: key.as_int(),
+        channel,
+        id: None,
+    };
+    let scaled = |v: midly::num::u7| v.as_int() as f32 / MAX_7_BIT;
+    Some(match message {
+        Wire::NoteOn { key, vel } if vel > 0 => MidiMessage::NoteOn {
+            note: note(key),
+            velocity: scaled(vel),
+        },
+        Wire::NoteOn { key, .. } | Wire::NoteOff { key, .. } => {
+            MidiMessage::NoteOff { note: note(key) }
+        }
+        Wire::Aftertouch { key, vel } => MidiMessage::PolyPressure {
+            note: note(key),
+            pressure: scaled(vel),
+        },
+        Wire::ChannelAftertouch { vel } => MidiMessage::ChannelPressure {
+            channel,
+            pressure: scaled(vel),
+        },
+        Wire::Controller { controller, value } => MidiMessage::Control {
+            channel,
+            cc: controller.as_int(),
+            value: scaled(value),
+        },
+        Wire::PitchBend { bend } => MidiMessage::PitchBend {
+            channel,
+            value: bend.0.as_int() as f32 / MAX_14_BIT,
+        },
+        Wire::ProgramChange { .. } => return None,
+    })
+}
+
+/// The messages of a parsed file, sorted by time.
+fn messages_of(smf: &Smf) -> Vec<TimedMidi> {
     let mut events = Vec::new();
     for track in &smf.tracks {
         let mut tick = 0u64;
@@ -126,20 +175,9 @@ fn notes_of(smf: &Smf) -> Vec<Note> {
                     micros_per_quarter: t.as_int(),
                 },
                 TrackEventKind::Midi { channel, message } => {
-                    let channel = channel.as_int();
-                    match message {
-                        MidiMessage::NoteOn { key, vel } if vel > 0 => Event::On {
-                            channel,
-                            key: key.as_int(),
-                            velocity: vel.as_int(),
-                        },
-                        MidiMessage::NoteOn { key, .. } | MidiMessage::NoteOff { key, .. } => {
-                            Event::Off {
-                                channel,
-                                key: key.as_int(),
-                            }
-                        }
-                        _ => continue,
+                    match message_of(channel.as_int(), message) {
+                        Some(m) => Event::Midi(m),
+                        None => continue,
                     }
                 }
                 _ => continue,
@@ -151,37 +189,17 @@ fn notes_of(smf: &Smf) -> Vec<Note> {
     events.sort_by_key(|&(tick, e)| (tick, !matches!(e, Event::Tempo { .. })));
 
     let mut clock = Clock::new(smf.header.timing);
-    let mut notes: Vec<Note> = Vec::new();
-    let mut held: HashMap<(u8, u8), VecDeque<usize>> = HashMap::new();
+    let mut messages = Vec::new();
     for (tick, e) in events {
-        let time_s = clock.seconds_at(tick);
         match e {
             Event::Tempo { micros_per_quarter } => clock.set_tempo(tick, micros_per_quarter),
-            Event::On {
-                channel,
-                key,
-                velocity,
-            } => {
-                held.entry((channel, key))
-                    .or_default()
-                    .push_back(notes.len());
-                notes.push(Note {
-                    key,
-                    velocity: velocity as f32 / MAX_VELOCITY,
-                    time_s,
-                    duration_s: None,
-                    speed_m_per_s: None,
-                    force: None,
-                });
-            }
-            Event::Off { channel, key } => {
-                if let Some(i) = held.get_mut(&(channel, key)).and_then(VecDeque::pop_front) {
-                    notes[i].duration_s = Some(time_s - notes[i].time_s);
-                }
-            }
+            Event::Midi(message) => messages.push(TimedMidi {
+                time_s: clock.seconds_at(tick),
+                message,
+            }),
         }
     }
-    notes
+    messages
 }
 
 /// Converts absolute ticks to seconds, following tempo changes in tick order.

@@ -3,11 +3,13 @@
 
 use super::{Controls, Material, MATERIAL_Q_RANGE, NUMERIC_CONTROLS};
 use crate::dsp::ExciterKind;
+use crate::engine::ExpressionTarget;
 
 impl Controls {
     /// Sets a control from text, as in `--set name=value`: any numeric control,
-    /// `material_q` (a number or `authored`), `material` (plastic, wood, ceramic, glass, metal)
-    /// or `exciter` (impulse, mallet, noise). Values outside a range are errors, not clamped.
+    /// `material_q` (a number or `authored`), `material` (plastic, wood, ceramic, glass, metal),
+    /// `exciter` (impulse, mallet, noise, scrape, roll, rub), `mod_wheel_target` and
+    /// `pressure_target` (none, position, damping, speed, force), `pruning` and `mpe` (on, off). Values outside a range are errors, not clamped.
     pub fn set_by_name(&mut self, name: &str, value: &str) -> Result<(), String> {
         let value = value.trim();
         match name {
@@ -32,16 +34,36 @@ impl Controls {
                 })?;
                 Ok(())
             }
-            "pruning" => {
-                self.pruning = match value.to_ascii_lowercase().as_str() {
+            "mod_wheel_target" | "pressure_target" => {
+                let target = ExpressionTarget::from_name(value).ok_or_else(|| {
+                    let names: Vec<_> = ExpressionTarget::ALL.iter().map(|t| t.name()).collect();
+                    format!(
+                        "{name}: expected one of {}, found \"{value}\"",
+                        names.join(", ")
+                    )
+                })?;
+                if name == "mod_wheel_target" {
+                    self.mod_wheel_target = target;
+                } else {
+                    self.pressure_target = target;
+                }
+                Ok(())
+            }
+            "pruning" | "mpe" => {
+                let on = match value.to_ascii_lowercase().as_str() {
                     "on" | "true" | "1" => true,
                     "off" | "false" | "0" => false,
                     _ => {
                         return Err(format!(
-                            "pruning: expected on or off (true, false, 1, 0), found \"{value}\""
+                            "{name}: expected on or off (true, false, 1, 0), found \"{value}\""
                         ))
                     }
                 };
+                if name == "mpe" {
+                    self.mpe = on;
+                } else {
+                    self.pruning = on;
+                }
                 Ok(())
             }
             "material_q" if value == "authored" => {
@@ -59,7 +81,13 @@ impl Controls {
                     .find(|s| s.name == name)
                     .ok_or_else(|| {
                         let mut names: Vec<_> = NUMERIC_CONTROLS.iter().map(|s| s.name).collect();
-                        names.extend(["material_q", "material", "exciter"]);
+                        names.extend([
+                            "material_q",
+                            "material",
+                            "exciter",
+                            "mod_wheel_target",
+                            "pressure_target",
+                        ]);
                         format!(
                             "unknown control \"{name}\"; known controls: {}",
                             names.join(", ")

@@ -16,17 +16,17 @@ use crate::units::gain_to_db;
 impl Engine {
     /// dB SPL of a unit amplitude at the output now: the playback level, through the output gain.
     pub(super) fn calibration_db(&self) -> f32 {
-        self.controls.playback_level_db_spl + gain_to_db(self.smoothed.gain)
+        self.expressed.playback_level_db_spl + gain_to_db(self.smoothed.gain)
     }
 
     /// Pruning's share of a control tick: analyses on frame boundaries (and after input wakes).
     pub(in crate::engine) fn prune_tick(&mut self, input_heard: bool) {
-        let cap = self.budget.cap(&self.controls, self.sample_rate_hz);
-        let wanted = self.controls.pruning || cap.is_some();
+        let cap = self.budget.cap(&self.expressed, self.sample_rate_hz);
+        let wanted = self.expressed.pruning || cap.is_some();
         if !wanted && !self.pruner.engaged {
             return;
         }
-        let frame = frame_samples(self.controls.analysis_frame_ms, self.sample_rate_hz);
+        let frame = frame_samples(self.expressed.analysis_frame_ms, self.sample_rate_hz);
         if !(self.clock.is_multiple_of(frame) || self.pruner.pending) {
             return;
         }

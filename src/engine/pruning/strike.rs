@@ -44,7 +44,7 @@ impl Engine {
         // than a frame later, so the cap holds within a control period.
         if self
             .budget
-            .cap(&self.controls, self.sample_rate_hz)
+            .cap(&self.expressed, self.sample_rate_hz)
             .is_some()
         {
             self.pruner.pending = true;
@@ -86,14 +86,14 @@ impl Engine {
         let modes = &mut self.voices[i].modes;
         // With pruning the modes are judged below; with a budget alone, ranked by energy;
         // otherwise the next analysis looks at them.
-        let pruning = self.controls.pruning;
+        let pruning = self.expressed.pruning;
         self.pruner.stats.absorbed += modes.absorb_strike(pulse, !pruning, |m| gains[m]) as u64;
         if modes.num_dormant() > 0 {
             // Dormant modes are left whatever comes of it: the analyses must go on even if
             // pruning and the budget are turned off before the next one, to bring them back.
             self.pruner.engaged = true;
             let bound = amplitude * kind.peak_bound(len);
-            let cap = self.budget.cap(&self.controls, self.sample_rate_hz);
+            let cap = self.budget.cap(&self.expressed, self.sample_rate_hz);
             if pruning {
                 self.judge_struck(i, bound, cap);
             } else if let Some(cap) = cap {
@@ -110,7 +110,7 @@ impl Engine {
     /// as it would start a silent one are woken, as many as the budget would keep.
     fn wake_within_budget(&mut self, i: usize, bound: f32, cap: usize) {
         let threshold = start_threshold(
-            db_to_gain(self.controls.truncation_db),
+            db_to_gain(self.expressed.truncation_db),
             self.bank.num_modes(),
         );
         let Engine {
