@@ -153,8 +153,8 @@ pub(super) fn objects() -> Vec<FactoryObject> {
         FactoryObject {
             name: "Rubbed wine glass",
             description: "A thin wine glass rubbed round its rim with a wet finger for as long \
-                          as a key is held: a pure, hovering tone that swells from nothing once \
-                          the finger grips, on the glass's lowest mode. Press too lightly or \
+                          as a key is held: a pure tone that swells from nothing within half \
+                          a second once the finger grips, on the glass's lowest mode. Press too lightly or \
                           move too fast and it will not sing; it rings on when let go. Velocity \
                           and pressure set how hard the finger presses, slide or the mod wheel \
                           its speed. The glass's stem is not modelled.",
@@ -178,9 +178,10 @@ pub(super) fn objects() -> Vec<FactoryObject> {
         FactoryObject {
             name: "Singing bowl (circled with a stick)",
             description: "A bronze singing bowl circled at its rim with a wooden stick for as \
-                          long as a key is held: a low hum that builds over a second or two, \
-                          beating slowly as the bowl's pairs of modes drift in and out of \
-                          step, and rings on for many seconds when the stick leaves it.",
+                          long as a key is held: a low hum that swells within half a second \
+                          and holds, and rings on for many seconds when the stick leaves it, \
+                          beating slowly as each pair of the bowl's modes drifts in and out \
+                          of step.",
             shape: Shape::Bowl(Bowl {
                 diameter_m: 0.2,
                 thickness_m: 0.004,
