@@ -193,7 +193,8 @@ fn main() {
         common::bench_bank().modes.len()
     );
     let struck = voice_realtime_factor(ExciterKind::Mallet, engine_seconds);
-    for kind in [ExciterKind::Scrape, ExciterKind::Roll] {
+    // A rub computes its voice a sample at a time (the friction answers the modes' velocity).
+    for kind in [ExciterKind::Scrape, ExciterKind::Roll, ExciterKind::Rub] {
         let held = voice_realtime_factor(kind, engine_seconds);
         println!(
             "  {:<8} real-time factor {:>8.1}x, struck {:>8.1}x: a contact voice costs {:.2}x a struck one",
