@@ -175,7 +175,10 @@ fn process_never_allocates_through_storms_sweeps_and_bank_swaps() {
             let phase = ((b + k * 5) % 40) as f64 / 39.0;
             let value = match *id {
                 "mat" => ((b + k) % 7) as f64,
-                "exc" | "inmode" | "modwhl" | "press" => ((b + k) % 3) as f64,
+                // Every exciter, contacts included.
+                "exc" => ((b + k) % 6) as f64,
+                "inmode" => ((b + k) % 3) as f64,
+                "modwhl" | "press" => ((b + k) % 5) as f64,
                 _ => phase,
             };
             events.push((t0 + (k * 3) % BLOCK, Send::Param(id, value)));
@@ -187,12 +190,19 @@ fn process_never_allocates_through_storms_sweeps_and_bank_swaps() {
             let id = (b * 8 + i) as u32;
             let channel = (i % 4) as u16;
             events.push((t, Send::NoteOn((30 + i * 9) as u16, channel, id, 0.8)));
-            let param = ["fine", "size", "posx", "posy", "hard"][i % 5];
+            let param = ["fine", "size", "posx", "posy", "hard", "cspeed", "cforce"][i % 7];
             events.push((t, Send::Mod(param, id, (i as f64 - 4.0) / 8.0)));
             let byte = ((b * 5 + i * 17) % 128) as u8;
             events.push((t + 1, Send::Midi([0xE0 | channel as u8, byte, byte])));
             events.push((t + 2, Send::Midi([0xD0 | channel as u8, byte, 0])));
             events.push((t + 3, Send::Midi([0xB0, 1, byte])));
+            // Slide, polyphonic pressure and the sustain pedal.
+            events.push((t + 4, Send::Midi([0xB0 | channel as u8, 74, byte])));
+            events.push((
+                t + 5,
+                Send::Midi([0xA0 | channel as u8, 30 + i as u8 * 9, byte]),
+            ));
+            events.push((t + 6, Send::Midi([0xB0 | channel as u8, 64, byte])));
         }
     }
     events.sort_by_key(|(t, _)| *t);
@@ -1228,13 +1238,21 @@ const GESTURES: [(usize, [u8; 3]); 13] = [
     (24_000, [0xB0, 64, 0]),
 ];
 
-/// `GESTURES` as a standard MIDI file.
-fn gestures_file(path: &std::path::Path) {
+/// `GESTURES` on MIDI channel `channel` (0 to 15).
+fn gestures_on(channel: u8) -> Vec<(usize, [u8; 3])> {
+    GESTURES
+        .iter()
+        .map(|&(at, [status, a, b])| (at, [status | channel, a, b]))
+        .collect()
+}
+
+/// `gestures` as a standard MIDI file.
+fn gestures_file(path: &std::path::Path, gestures: &[(usize, [u8; 3])]) {
     use midly::num::{u15, u28};
     use midly::{live::LiveEvent, Format, Header, Smf, Timing, TrackEvent, TrackEventKind};
     let mut track = Vec::new();
     let mut last = 0;
-    for &(sample, bytes) in &GESTURES {
+    for &(sample, bytes) in gestures {
         assert_eq!(sample % SAMPLES_PER_TICK, 0);
         let tick = sample / SAMPLES_PER_TICK;
         let len = if bytes[0] & 0xF0 == 0xD0 { 2 } else { 3 };
@@ -1268,17 +1286,25 @@ fn a_midi_file_rendered_offline_equals_the_plugin_playing_it() {
     use std::sync::Arc;
 
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("gestures.mid");
-    gestures_file(&path);
-    let messages = read_midi_file(&path).unwrap();
     let bank = two_position_bank();
     let state = state_with(&bank);
     let samples = 36_000;
-    // Struck (pressure damps, the wheel moves the strike), and scraped (pressure is the force,
-    // slide the speed).
-    for (exciter, index) in [(ExciterKind::Mallet, 0.0), (ExciterKind::Scrape, 3.0)] {
-        let mut events: Vec<(usize, Send)> = vec![(0, Send::Param("exc", index))];
-        events.extend(GESTURES.iter().map(|&(at, bytes)| (at, Send::Midi(bytes))));
+    // Struck (pressure damps, the wheel moves the strike), scraped (pressure is the force, slide
+    // the speed), and rubbed on an MPE member channel (its bend, pressure and slide the note's).
+    for (exciter, index, mpe) in [
+        (ExciterKind::Mallet, 0.0, false),
+        (ExciterKind::Scrape, 3.0, false),
+        (ExciterKind::Rub, 5.0, true),
+    ] {
+        let gestures = gestures_on(if mpe { 2 } else { 0 });
+        let path = dir.path().join(format!("{}.mid", exciter.name()));
+        gestures_file(&path, &gestures);
+        let messages = read_midi_file(&path).unwrap();
+        let mut events: Vec<(usize, Send)> = vec![
+            (0, Send::Param("exc", index)),
+            (0, Send::Param("mpe", if mpe { 1.0 } else { 0.0 })),
+        ];
+        events.extend(gestures.iter().map(|&(at, bytes)| (at, Send::Midi(bytes))));
         let played = run(&Script {
             state: Some(&state),
             events: &events,
@@ -1286,6 +1312,7 @@ fn a_midi_file_rendered_offline_equals_the_plugin_playing_it() {
         });
         let mut controls = ModalParams::new(false).controls();
         controls.exciter = exciter;
+        controls.mpe = mpe;
         let settings = RenderSettings {
             controls,
             max_seconds: samples as f64 / RATE,

@@ -372,3 +372,72 @@ fn polyphonic_modulation_sets_one_contact_notes_speed_and_force() {
         "centroid {c_fast:.0} Hz against {c_slow:.0} Hz"
     );
 }
+
+/// Largest sample-to-sample step of each 10 ms window over the window's peak.
+fn step_over_peak(x: &[f32]) -> Vec<f32> {
+    x.chunks(480)
+        .map(|w| max_step(w) / peak(w).max(1e-9))
+        .collect()
+}
+
+#[test]
+fn a_rub_follows_speed_and_force_sweeps_without_a_click() {
+    let bank = simple_bank(&[(660.0, 0.4, 1.0), (1_580.0, 1.5, 0.6)]);
+    let mut e = contact_engine(&bank, ExciterKind::Rub, 0.2);
+    let mut events = vec![on(0, KEY, 1.0)];
+    // From 1.5 s, the slide sweeps the speed from 0.15 to 0.45 m/s and back, and the pressure the
+    // force from 0.7 to 0.4, in steps of 2 ms as a controller sends them.
+    for i in 0..1_000 {
+        let t = 1.5 + i as f64 * 0.002;
+        let u = i as f32 / 999.0;
+        let speed = 0.15 + 0.3 * (1.0 - (2.0 * u - 1.0).abs());
+        let time = (t * RATE as f64) as u32;
+        events.push(NoteEvent::Expression {
+            time,
+            note: note(),
+            expression: NoteExpression::Slide(speed / 3.0),
+        });
+        events.push(NoteEvent::Expression {
+            time,
+            note: note(),
+            expression: NoteExpression::Pressure(0.7 - 0.3 * u),
+        });
+    }
+    let x = play(&mut e, &events, 4.0);
+    // Louder as it goes faster (the level follows the speed).
+    let (slow, fast) = (rms(span(&x, 1.3, 1.5)), rms(span(&x, 2.45, 2.55)));
+    assert!(fast > 2.0 * slow, "0.15 m/s: {slow}, 0.45 m/s: {fast}");
+    // Every 10 ms window's steps stay within what the steady song's own waveform makes.
+    let steady = step_over_peak(span(&x, 1.0, 1.5));
+    let held = steady.iter().fold(0.0f32, |a, &b| a.max(b));
+    let sweep = step_over_peak(span(&x, 1.5, 3.5));
+    let worst = sweep.iter().fold(0.0f32, |a, &b| a.max(b));
+    assert!(
+        worst < 1.25 * held,
+        "a step of {worst} of the window's peak in the sweep, {held} held"
+    );
+}
+
+#[test]
+fn a_scrape_ends_in_a_knock_on_the_same_voice() {
+    let bank = dense_bank(200, 110.0);
+    // Scraped for a second, then the key struck again at the same velocity: the knock adds a
+    // mallet strike on the same voice, and the scrape goes on as it was.
+    let mut e = contact_engine(&bank, ExciterKind::Scrape, 0.5);
+    let knocked = play(&mut e, &[on(0, KEY, 0.5), on(48_000, KEY, 0.5)], 1.6);
+    assert_eq!(e.stats().voices, 1, "the knock took another voice");
+    let mut e = contact_engine(&bank, ExciterKind::Scrape, 0.5);
+    let scraped = play(&mut e, &[on(0, KEY, 0.5)], 1.6);
+    assert_eq!(&knocked[..48_000], &scraped[..48_000]);
+    let knock: Vec<f32> = knocked.iter().zip(&scraped).map(|(a, b)| a - b).collect();
+    // The difference is a mallet strike at that velocity.
+    let mut m = contact_engine(&bank, ExciterKind::Mallet, 0.5);
+    let struck = play(&mut m, &[on(0, KEY, 0.5)], 0.6);
+    let ratio = peak(span(&knock, 1.0, 1.6)) / peak(&struck);
+    assert!(
+        (0.7..1.4).contains(&ratio),
+        "the knock peaks at {ratio} of a strike"
+    );
+    let scraping = rms(span(&scraped, 1.4, 1.6));
+    assert!(scraping > 1e-3, "the scrape stopped");
+}

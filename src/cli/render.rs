@@ -23,10 +23,13 @@ use super::{check_output_dir, load_bank, same_file, STDOUT};
 pub(super) struct RenderArgs {
     /// Bank file (JSON) or factory preset name.
     bank: String,
-    /// Notes as key:velocity@time_s[+duration_s], comma-separated, e.g. "60:0.8@0, 64:0.5@0.25+0.5".
+    /// Notes as key:velocity@time_s[+duration_s], comma-separated, e.g.
+    /// "60:0.8@0, 64:0.5@0.25+0.5"; a contact note may add speed=A..B (m/s) and force=A..B,
+    /// e.g. "60:1@0+2 speed=0.2..1.5".
     #[arg(long)]
     notes: Option<String>,
-    /// Standard MIDI file to play (all tracks and channels).
+    /// Standard MIDI file to play (all tracks and channels; bends, pedal, wheel, pressure and
+    /// CC 74 as the plugins play them).
     #[arg(long, value_name = "FILE")]
     midi: Option<PathBuf>,
     /// WAV file to write (a symbolic link's target is replaced, an existing file keeps its
@@ -235,7 +238,7 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
             args.bits.name()
         );
     }
-    if silent && notes.is_empty() {
+    if silent && score.first_note_from(0.0).is_none() {
         eprintln!(
             "warning: the render is silent: there are no notes to play (a MIDI file with no \
              note-on, or only tempo and other meta events)"

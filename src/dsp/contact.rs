@@ -75,7 +75,7 @@ const BUMP_WIDTH: f64 = 0.25;
 const GROUND_GAIN: f32 = 0.4;
 
 /// Force of a rolling object's tallest bump, relative: held, the factory table rolled on at
-/// 0.6 m/s peaks at -10.4 dBFS, the factory steel sheet scraped at 0.4 m/s at -6.2 dBFS
+/// 0.6 m/s peaks at -9.6 dBFS, the factory steel sheet scraped at 0.4 m/s at -6.1 dBFS
 /// (`tests/factory_presets.rs`).
 const BUMP_GAIN: f32 = 16.0;
 
@@ -105,8 +105,8 @@ pub const RUB_LOOP_GAIN: f32 = 0.5;
 /// force over the mass the contact point moves).
 const RUB_ACCELERATION: f64 = 150.0;
 
-/// Fastest rub, m/s: a rub's level follows its speed.
-const RUB_MAX_SPEED_M_PER_S: f64 = 10.0;
+/// Fastest rub, m/s (the fastest contact the engine plays): a rub's level follows its speed.
+const RUB_MAX_SPEED_M_PER_S: f64 = 3.0;
 
 /// Corner of the high-pass on a rub's force, Hz.
 pub const RUB_DC_HZ: f64 = 5.0;
@@ -335,6 +335,13 @@ impl Contact {
         let k = self.smoothing;
         self.speed += (target_speed - self.speed) * k;
         self.force += (target_force - self.force) * k as f32;
+        // Settled values snap to their targets (no subnormal tail on the way to zero).
+        if (target_speed - self.speed).abs() < 1e-9 {
+            self.speed = target_speed;
+        }
+        if (target_force - self.force).abs() < 1e-9 {
+            self.force = target_force;
+        }
         let relative = (self.speed as f32 - RUB_M_PER_S_PER_UNIT * velocity) / RUB_FALL_M_PER_S;
         // A unit force moves the contact point `RUB_M_PER_S_PER_UNIT * gain_sum` in one sample:
         // full friction at full force accelerates it at `RUB_ACCELERATION`.
@@ -418,8 +425,8 @@ fn targets(speed_m_per_s: f32, force: f32) -> (f64, f32) {
     (speed, force)
 }
 
-/// RMS of the eased lattice heights over a long path (lattice values uniform in [-1, 1], eased): measured,
-/// to normalise the profile.
+/// RMS of the eased lattice heights over a long path (lattice values uniform in [-1, 1], eased):
+/// measured, to normalise the profile.
 const VALUE_NOISE_RMS: f32 = 0.48;
 
 /// The random heights in [-1, 1) of `octave`'s lattice at cell `i` and the next: the profile

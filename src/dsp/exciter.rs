@@ -224,6 +224,11 @@ impl Exciter {
         self.contact_force = 0.0;
     }
 
+    /// Whether a contact is under way: held, or dying away after its release.
+    pub fn in_contact(&self) -> bool {
+        self.in_contact
+    }
+
     /// Whether a rub is under way: its force comes sample by sample from [`Exciter::rub_force`]
     /// rather than from [`Exciter::render`].
     pub fn is_rubbing(&self) -> bool {

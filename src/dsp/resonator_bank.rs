@@ -492,8 +492,6 @@ impl ResonatorBank {
     }
 }
 
-/// How many of the states `re + i im` have `|z|^2` not above `threshold_sq` (not-a-number
-/// counts).
 /// The sum of `re` with the signs of `gain`, in eight independent lanes (so it vectorises).
 fn signed_sum(re: &[f32], gain: &[f32]) -> f32 {
     let mut lanes = [0.0f32; COLUMNS];
@@ -505,6 +503,8 @@ fn signed_sum(re: &[f32], gain: &[f32]) -> f32 {
     lanes.iter().sum()
 }
 
+/// How many of the states `re + i im` have `|z|^2` not above `threshold_sq` (not-a-number
+/// counts).
 fn count_not_above(re: &[f32], im: &[f32], threshold_sq: f32) -> usize {
     #[cfg(target_arch = "x86_64")]
     {

@@ -6,10 +6,13 @@
 //!   ([`NoteEvent::Controller`]): the engine moves its controls from their sample on, through
 //!   the bend range and the wheel's and pressure's targets ([`Controls::expressed`]).
 //! - With MPE on, a member channel's (2 to 16) bend, pressure and slide are its note's, and are
-//!   sent with a note that starts there after them; the manager channel's (1) act on every note.
+//!   sent with a note that starts there after them; the manager channel's (1) bend, pressure and
+//!   wheel act on every note (its slide, as any channel's, on its own notes).
 //! - Polyphonic pressure, and channel pressure on a member channel, is a note's pressure: it damps
 //!   a struck note when pressure is routed to damping, and is a contact's force whatever the
-//!   routing; otherwise it is left alone.
+//!   routing; otherwise it is left alone. With a contact exciter and pressure routed to damping
+//!   (which a contact note does not take), channel pressure is its channel's notes' force too:
+//!   pressing harder on a plain keyboard presses the contact harder.
 //! - CC 74 is the slide of the notes of its channel (a contact's speed), and of notes that start
 //!   there after it.
 //! - The sustain pedal (CC 64, down from 64) holds the notes released while it is down until it
@@ -222,6 +225,14 @@ impl MidiInput {
                             expression: NoteExpression::Pressure(pressure),
                         });
                     }
+                } else if controls.exciter.is_contact()
+                    && controls.pressure_target == ExpressionTarget::Damping
+                {
+                    emit(NoteEvent::ChannelExpression {
+                        time,
+                        channel,
+                        expression: NoteExpression::Pressure(pressure),
+                    });
                 } else {
                     emit(NoteEvent::Controller {
                         time,

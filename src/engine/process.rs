@@ -650,8 +650,6 @@ impl Engine {
     }
 }
 
-/// One smoothing step from `current` towards `target` by fraction `k`, snapping to the target
-/// once within `snap`.
 /// Advances voice `v`'s modes over a run, driven by `x` when `driven` (its exciter's strikes and
 /// scrape or roll), and by its rub's friction sample by sample while it is rubbed.
 fn drive_voice(v: &mut Voice, kernel: Kernel, driven: bool, x: &[f32], out: &mut [[f32; COLUMNS]]) {
@@ -668,6 +666,8 @@ fn drive_voice(v: &mut Voice, kernel: Kernel, driven: bool, x: &[f32], out: &mut
     }
 }
 
+/// One smoothing step from `current` towards `target` by fraction `k`, snapping to the target
+/// once within `snap`.
 fn step_towards(current: f64, target: f64, k: f64, snap: f64) -> f64 {
     let next = current + (target - current) * k;
     if (target - next).abs() <= snap || !next.is_finite() {

@@ -109,7 +109,7 @@ pub struct Voice {
     /// Per-note pressure 0 to 1 (note expression): the contact's force on a contact note, else
     /// damping the object like a hand on it.
     pub pressure: f32,
-    /// Whether the note plays a contact (scrape, roll) rather than a strike.
+    /// Whether the note plays a contact (scrape, roll, rub) rather than a strike.
     pub contact: bool,
     /// A contact note's force from its velocity, until pressure takes over (0 to 1).
     pub contact_velocity: f32,
@@ -271,8 +271,9 @@ impl Voice {
         }
         self.modes.set_gains_with(|m| gains[m]);
         self.retune(bank, decay, sample_rate_hz, tuning);
-        // A contact is started by the engine, which knows its controls.
-        if !kind.is_contact() {
+        // A contact is started by the engine, which knows its controls. A key struck again while
+        // its contact goes on knocks the object (a mallet strike), and the contact goes on.
+        if !kind.is_contact() || self.exciter.in_contact() {
             self.exciter.strike(kind, amplitude, len_samples);
         }
     }

@@ -445,6 +445,10 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
         };
         let mut engine = build_engine(&bank, self.params.polyphony(), rate, max_block);
         engine.set_last_key(self.last_key);
+        // The wheels are where the player left them, whatever the host's new settings.
+        if let Some(current) = self.engines.current.as_ref() {
+            engine.set_controllers(current.controllers());
+        }
         self.engines.activate(engine, generation);
         true
     }

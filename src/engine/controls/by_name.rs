@@ -9,7 +9,8 @@ impl Controls {
     /// Sets a control from text, as in `--set name=value`: any numeric control,
     /// `material_q` (a number or `authored`), `material` (plastic, wood, ceramic, glass, metal),
     /// `exciter` (impulse, mallet, noise, scrape, roll, rub), `mod_wheel_target` and
-    /// `pressure_target` (none, position, damping, speed, force), `pruning` and `mpe` (on, off). Values outside a range are errors, not clamped.
+    /// `pressure_target` (none, position, damping, speed, force), `pruning` and `mpe` (on, off).
+    /// Values outside a range are errors, not clamped.
     pub fn set_by_name(&mut self, name: &str, value: &str) -> Result<(), String> {
         let value = value.trim();
         match name {

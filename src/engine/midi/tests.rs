@@ -186,6 +186,24 @@ fn slide_and_poly_pressure_reach_the_notes() {
     assert!(
         matches!(events[1], NoteEvent::Expression { expression: NoteExpression::Pressure(p), .. } if p == 0.75)
     );
+    // Channel pressure routed to damping, which a contact does not take, is its channel's
+    // notes' force; routed elsewhere it goes there.
+    let aftertouch = MidiMessage::ChannelPressure {
+        channel: 5,
+        pressure: 0.5,
+    };
+    let damping = Controls {
+        pressure_target: ExpressionTarget::Damping,
+        ..contact.clone()
+    };
+    let events = read_all(&damping, &[aftertouch]);
+    assert!(
+        matches!(events[0], NoteEvent::ChannelExpression { channel: 5, expression: NoteExpression::Pressure(p), .. } if p == 0.5)
+    );
+    let events = read_all(&contact, &[aftertouch]);
+    assert!(
+        matches!(events[0], NoteEvent::Controller { change: ControlChange::Pressure(p), .. } if p == 0.5)
+    );
     // All notes off forgets what the pedal held.
     let all_off = MidiMessage::Control {
         channel: 0,

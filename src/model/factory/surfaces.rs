@@ -105,7 +105,7 @@ pub(super) fn objects() -> Vec<FactoryObject> {
             name: "Scraped steel sheet",
             description: "A thin steel sheet scraped with a metal edge for as long as a key is \
                           held: a rasping, ringing screech that brightens as the scrape speeds \
-                          up (pressure sets the force, slide or the mod wheel the speed) and \
+                          up (pressure sets the force, slide the speed) and \
                           rings on when it stops.",
             shape: Shape::RectangularPlate(RectangularPlate {
                 length_x_m: 0.5,
@@ -154,9 +154,9 @@ pub(super) fn objects() -> Vec<FactoryObject> {
             name: "Rubbed wine glass",
             description: "A thin wine glass rubbed round its rim with a wet finger for as long \
                           as a key is held: a pure tone that swells from nothing within half \
-                          a second once the finger grips, on the glass's lowest mode. Press too lightly or \
-                          move too fast and it will not sing; it rings on when let go. Velocity \
-                          and pressure set how hard the finger presses, slide or the mod wheel \
+                          a second once the finger grips, on the glass's lowest mode. Press \
+                          too lightly or move too fast and it will not sing; it rings on when \
+                          let go. Velocity and pressure set how hard the finger presses, slide \
                           its speed. The glass's stem is not modelled.",
             shape: Shape::Bowl(Bowl {
                 diameter_m: 0.075,
