@@ -185,7 +185,7 @@ pub enum NoteEvent {
 pub enum NoteExpression {
     /// Tuning offset in semitones, smoothed like pitch bend.
     Tuning(f32),
-    /// Pressure 0 to 1: the force of a contact note (scrape, roll); on a struck note, damping
+    /// Pressure 0 to 1: the force of a contact note (scrape, roll, rub); on a struck note, damping
     /// like a hand pressing on the object.
     Pressure(f32),
     /// Slide 0 to 1 (MPE's CC 74, CLAP's brightness): the speed of a contact note, from still

@@ -139,14 +139,15 @@ pub enum ExpressionTarget {
     #[id = "position"]
     #[name = "Strike position"]
     Position,
-    /// Damps the object, as a hand pressing on it.
+    /// Damps the object, as a hand pressing on it (channel pressure routed here presses a
+    /// contact instead: its force).
     #[id = "damping"]
     Damping,
-    /// Sets the speed of a scrape or roll, from still to the fastest.
+    /// Sets the speed of a scrape, roll or rub, from still to the fastest.
     #[id = "speed"]
     #[name = "Contact speed"]
     Speed,
-    /// Sets the force of a scrape or roll.
+    /// Sets the force of a scrape, roll or rub.
     #[id = "force"]
     #[name = "Contact force"]
     Force,
@@ -303,10 +304,10 @@ pub struct StrikeParams {
     /// Radius of a rolling object, in mm.
     #[id = "radius"]
     pub rolling_radius: FloatParam,
-    /// Speed of a scrape or roll, in m/s.
+    /// Speed of a scrape, roll or rub, in m/s.
     #[id = "cspeed"]
     pub contact_speed: FloatParam,
-    /// Force of a scrape or roll at full velocity.
+    /// Force of a scrape, roll or rub at full velocity.
     #[id = "cforce"]
     pub contact_force: FloatParam,
 }

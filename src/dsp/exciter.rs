@@ -224,9 +224,9 @@ impl Exciter {
         self.contact_force = 0.0;
     }
 
-    /// Whether a contact is under way: held, or dying away after its release.
-    pub fn in_contact(&self) -> bool {
-        self.in_contact
+    /// Whether a contact is held (under way and not let go).
+    pub fn holds_contact(&self) -> bool {
+        self.in_contact && !self.contact_released
     }
 
     /// Whether a rub is under way: its force comes sample by sample from [`Exciter::rub_force`]
@@ -371,6 +371,26 @@ mod tests {
             energy += buf.iter().map(|x| x * x).sum::<f32>();
         }
         (sum, energy)
+    }
+
+    #[test]
+    fn a_contact_let_go_is_no_longer_held_while_it_dies_away() {
+        let mut e = Exciter::new(7);
+        assert!(!e.holds_contact());
+        e.start_contact(
+            ContactKind::Scrape { width_m: 1e-3 },
+            0.5,
+            48_000.0,
+            0.5,
+            0.7,
+        );
+        let mut buf = [0.0f32; 480];
+        assert!(e.render(&mut buf) && e.holds_contact());
+        e.release_contact();
+        // Still sounding (its force falls over a few ms), but not held: a key struck now does
+        // not knock.
+        assert!(e.render(&mut buf[..8]) && !e.is_idle());
+        assert!(!e.holds_contact());
     }
 
     #[test]

@@ -132,9 +132,9 @@ pub struct Controls {
     pub roughness: f32,
     /// Radius of a rolling object, in mm.
     pub rolling_radius_mm: f32,
-    /// Contact speed of a scrape or roll, in m/s.
+    /// Contact speed of a scrape, roll or rub, in m/s.
     pub contact_speed_m_per_s: f32,
-    /// Normal force of a scrape or roll at full velocity, 0 to 1.
+    /// Normal force of a scrape, roll or rub at full velocity, 0 to 1.
     pub contact_force: f32,
     /// Damping applied on note-off: 0 lets the object ring on, 1 damps it within about 50 ms.
     pub release_damping: f32,
@@ -418,7 +418,7 @@ pub const VARIATION_DECAY: f32 = 0.05;
 /// Most a mode's gain changes at full strike variation, in dB (either way).
 pub const VARIATION_GAIN_DB: f32 = 1.5;
 
-/// Fastest scrape or roll, in m/s: a quick stroke of the hand.
+/// Fastest scrape, roll or rub, in m/s: a quick stroke of the hand.
 pub const CONTACT_SPEED_MAX_M_PER_S: f32 = CONTACT_SPEED_M_PER_S.max as f32;
 
 /// A model range as the `(min, max)` of a control.

@@ -85,13 +85,19 @@ impl Controllers {
 impl Controls {
     /// These controls as the controllers move them: the bend adds its share of the bend range
     /// to the pitch bend, and the mod wheel and pressure each move their target (the strike
-    /// position towards the far end, damping, or a contact's speed or force).
+    /// position towards the far end, damping, or a contact's speed or force). Pressure routed to
+    /// damping does not damp a contact: it is the contact notes' own force
+    /// ([`super::MidiInput`]).
     pub fn expressed(&self, c: &Controllers) -> Controls {
         let mut out = self.clone();
         out.pitch_bend_semitones += c.bend * self.bend_range_semitones;
+        let pressure_target = match self.pressure_target {
+            ExpressionTarget::Damping if self.exciter.is_contact() => ExpressionTarget::None,
+            target => target,
+        };
         for (target, amount) in [
             (self.mod_wheel_target, c.mod_wheel),
-            (self.pressure_target, c.pressure),
+            (pressure_target, c.pressure),
         ] {
             match target {
                 ExpressionTarget::None => {}

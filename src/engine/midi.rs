@@ -10,9 +10,9 @@
 //!   wheel act on every note (its slide, as any channel's, on its own notes).
 //! - Polyphonic pressure, and channel pressure on a member channel, is a note's pressure: it damps
 //!   a struck note when pressure is routed to damping, and is a contact's force whatever the
-//!   routing; otherwise it is left alone. With a contact exciter and pressure routed to damping
-//!   (which a contact note does not take), channel pressure is its channel's notes' force too:
-//!   pressing harder on a plain keyboard presses the contact harder.
+//!   routing; otherwise it is left alone. Without MPE, with a contact exciter and pressure routed
+//!   to damping, channel pressure is its channel's notes' force too (and sent with a note that
+//!   starts there after it): pressing harder on a plain keyboard presses the contact harder.
 //! - CC 74 is the slide of the notes of its channel (a contact's speed), and of notes that start
 //!   there after it.
 //! - The sustain pedal (CC 64, down from 64) holds the notes released while it is down until it
@@ -147,6 +147,14 @@ impl MidiInput {
         let pressure_is_the_notes =
             controls.exciter.is_contact() || controls.pressure_target == ExpressionTarget::Damping;
         let index = |channel: u8| channel as usize % CHANNELS;
+        // Channel pressure is its channel's notes' own: on MPE member channels, and, without
+        // MPE, on a contact when routed to damping (which would damp it instead of pressing).
+        let channel_pressure_is_the_notes = |channel: u8| {
+            is_member(channel)
+                || (!mpe
+                    && controls.exciter.is_contact()
+                    && controls.pressure_target == ExpressionTarget::Damping)
+        };
         match message {
             MidiMessage::NoteOn { note, velocity } if velocity > 0.0 => {
                 // Pressed again, it is held by its key, not by the pedal.
@@ -169,9 +177,9 @@ impl MidiInput {
                 if is_member(note.channel) {
                     let bend = self.channel_bend[c] * controls.mpe_bend_range_semitones;
                     express(NoteExpression::Tuning(bend));
-                    if pressure_is_the_notes {
-                        express(NoteExpression::Pressure(self.channel_pressure[c]));
-                    }
+                }
+                if channel_pressure_is_the_notes(note.channel) && pressure_is_the_notes {
+                    express(NoteExpression::Pressure(self.channel_pressure[c]));
                 }
                 if let Some(slide) = self.channel_slide[c] {
                     express(NoteExpression::Slide(slide));
@@ -216,7 +224,7 @@ impl MidiInput {
             }
             MidiMessage::ChannelPressure { channel, pressure } => {
                 let pressure = pressure.clamp(0.0, 1.0);
-                if is_member(channel) {
+                if channel_pressure_is_the_notes(channel) {
                     self.channel_pressure[index(channel)] = pressure;
                     if pressure_is_the_notes {
                         emit(NoteEvent::ChannelExpression {
@@ -225,14 +233,6 @@ impl MidiInput {
                             expression: NoteExpression::Pressure(pressure),
                         });
                     }
-                } else if controls.exciter.is_contact()
-                    && controls.pressure_target == ExpressionTarget::Damping
-                {
-                    emit(NoteEvent::ChannelExpression {
-                        time,
-                        channel,
-                        expression: NoteExpression::Pressure(pressure),
-                    });
                 } else {
                     emit(NoteEvent::Controller {
                         time,

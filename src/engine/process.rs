@@ -483,7 +483,7 @@ impl Engine {
         }
     }
 
-    /// Starts voice `i`'s contact of `kind` (a scrape or roll) at velocity-derived force
+    /// Starts voice `i`'s contact of `kind` (a scrape, roll or rub) at velocity-derived force
     /// `amplitude`, its width from `hardness_ms`. A note released at the sample it started
     /// (a click on the strike pad, a note of no length) lets go of it at once.
     fn start_contact(&mut self, i: usize, kind: ExciterKind, amplitude: f32, hardness_ms: f32) {

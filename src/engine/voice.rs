@@ -273,7 +273,7 @@ impl Voice {
         self.retune(bank, decay, sample_rate_hz, tuning);
         // A contact is started by the engine, which knows its controls. A key struck again while
         // its contact goes on knocks the object (a mallet strike), and the contact goes on.
-        if !kind.is_contact() || self.exciter.in_contact() {
+        if !kind.is_contact() || self.exciter.holds_contact() {
             self.exciter.strike(kind, amplitude, len_samples);
         }
     }

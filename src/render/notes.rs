@@ -66,7 +66,7 @@ impl fmt::Display for Note {
 
 /// Parses a comma-separated note list such as `"60:0.8@0.0, 64:0.5@0.25+0.5"`: each item is
 /// `key:velocity@time_s`, optionally followed by `+duration_s` for a note-off, then for a held
-/// contact (scrape, roll) `speed=A..B` (m/s) and `force=A..B` (0 to 1), ramps from the strike to
+/// contact (scrape, roll, rub) `speed=A..B` (m/s) and `force=A..B` (0 to 1), ramps from the strike to
 /// the release (`speed=A` holds one value). Whitespace around items and fields is ignored. Errors
 /// name the item (1-based) and what was expected.
 pub fn parse_notes(text: &str) -> Result<Vec<Note>, String> {

@@ -196,9 +196,33 @@ fn slide_and_poly_pressure_reach_the_notes() {
         pressure_target: ExpressionTarget::Damping,
         ..contact.clone()
     };
-    let events = read_all(&damping, &[aftertouch]);
+    let events = read_all(&damping, &[aftertouch, on(5, 62)]);
     assert!(
         matches!(events[0], NoteEvent::ChannelExpression { channel: 5, expression: NoteExpression::Pressure(p), .. } if p == 0.5)
+    );
+    // A note struck while the key is pressed down takes the pressure with it.
+    assert!(
+        matches!(events[2], NoteEvent::Expression { expression: NoteExpression::Pressure(p), .. } if p == 0.5)
+    );
+    // Damping does not damp a contact (its pressure is the notes' force).
+    let pressed = crate::engine::Controllers {
+        pressure: 1.0,
+        ..Default::default()
+    };
+    assert_eq!(damping.expressed(&pressed).extra_damping, 0.0);
+    assert_eq!(Controls::default().expressed(&pressed).extra_damping, 1.0);
+    // With MPE the manager channel's pressure stays channel-wide.
+    let mpe = Controls {
+        mpe: true,
+        ..damping.clone()
+    };
+    let manager = MidiMessage::ChannelPressure {
+        channel: 0,
+        pressure: 0.5,
+    };
+    let events = read_all(&mpe, &[manager]);
+    assert!(
+        matches!(events[0], NoteEvent::Controller { change: ControlChange::Pressure(p), .. } if p == 0.5)
     );
     let events = read_all(&contact, &[aftertouch]);
     assert!(
