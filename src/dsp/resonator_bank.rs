@@ -331,25 +331,13 @@ impl ResonatorBank {
         mut friction: impl FnMut(f32, f32) -> f32,
         acc: &mut [[f32; COLUMNS]],
     ) {
-        if self.coeffs_stale {
-            self.refresh_coeffs();
-        }
         let n = self.num_computed(kernel);
         let gain_sum: f32 = self.gain[..n].iter().map(|g| g.abs()).sum();
         for (x, sum) in input.iter().zip(acc.iter_mut()) {
             let velocity = signed_sum(&self.re[..n], &self.gain[..n]);
             let drive = x + friction(velocity, gain_sum);
-            self.clock += 1;
-            self.computed += n as u64;
-            kernels::process(
+            self.process(
                 kernel,
-                Rows {
-                    re: &mut self.re[..n],
-                    im: &mut self.im[..n],
-                    q_re: &self.q_re[..n],
-                    q_im: &self.q_im[..n],
-                    gain: &self.gain[..n],
-                },
                 Some(std::slice::from_ref(&drive)),
                 std::slice::from_mut(sum),
             );

@@ -33,8 +33,9 @@ impl<K: Kind> ModalPlugin<K> {
     /// polyphonic modulation directly.
     pub(super) fn read_events(&mut self, context: &mut impl ProcessContext<Self>) {
         self.events.clear();
-        // The settings MIDI is read with: MPE, bend ranges, pressure routing, exciter.
-        self.midi_controls = self.params.controls();
+        // The block's controls; MIDI is read with their MPE setting, bend ranges, pressure
+        // routing and exciter.
+        self.block_controls = self.params.controls();
         self.read_auditions();
         while let Some(event) = context.next_event() {
             let midi = match event {
@@ -184,11 +185,12 @@ impl<K: Kind> ModalPlugin<K> {
             };
             if let Some((time, message)) = midi {
                 let events = &mut self.events;
-                self.midi.read(time, message, &self.midi_controls, |event| {
-                    if events.len() < MAX_EVENTS {
-                        events.push(event);
-                    }
-                });
+                self.midi
+                    .read(time, message, &self.block_controls, |event| {
+                        if events.len() < MAX_EVENTS {
+                            events.push(event);
+                        }
+                    });
             }
         }
     }

@@ -112,8 +112,8 @@ pub struct ModalPlugin<K: Kind> {
     onsets: OnsetTrigger,
     /// The MIDI being played: channels' controllers, pedals, sustained notes.
     midi: MidiInput,
-    /// The controls MIDI is read with this block.
-    midi_controls: Controls,
+    /// The engine's controls from the parameters, for this block (MIDI is read with them).
+    block_controls: Controls,
     /// Last key struck, if any: the pitch of onsets (else the bank's root).
     last_key: Option<u8>,
     /// The dry/wet mix, ramped from segment to segment.
@@ -146,7 +146,7 @@ impl<K: Kind> Default for ModalPlugin<K> {
             dry: [Vec::new(), Vec::new()],
             onsets: OnsetTrigger::new(48_000.0),
             midi: MidiInput::default(),
-            midi_controls: Controls::default(),
+            block_controls: Controls::default(),
             last_key: None,
             dry_wet: DryWet::default(),
             bypass: Bypass::default(),
@@ -227,7 +227,7 @@ impl<K: Kind> ModalPlugin<K> {
         }
         let drive = (have_input && mode == InputMode::Direct).then_some(&self.input[..n]);
 
-        let controls = self.params.controls();
+        let controls = self.block_controls.clone();
         let (left, rest) = channels.split_at_mut(1);
         let (out_l, out_r) = (&mut left[0][start..end], &mut rest[0][start..end]);
         let Some(engine) = self.engines.current.as_mut() else {

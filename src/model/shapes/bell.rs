@@ -25,7 +25,6 @@
 
 use super::{ModeLimits, ShapeError, ShapedMode};
 use crate::model::materials::Material;
-use std::f64::consts::TAU;
 
 /// One partial of the tuned bell.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -61,9 +60,6 @@ pub const TUNED_BELL_PARTIALS: [BellPartial; 11] = [
 /// Where the clapper strikes: the middle of the sound bow, on the quint's nodal circle.
 pub const SOUND_BOW: f64 = 0.9;
 
-/// `m (m^2 - 1) / sqrt(m^2 + 1)` at m = 2: the ring's lowest bending mode.
-const RING_MODE_2_FACTOR: f64 = 2.683_281_572_999_747_6; // 6 / sqrt(5)
-
 /// A church bell of the classic Western profile.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TunedBell {
@@ -74,12 +70,9 @@ pub struct TunedBell {
 }
 
 impl TunedBell {
-    /// Hum frequency in Hz, from the thin-ring estimate.
+    /// Hum frequency in Hz, from the thin-ring estimate: the ring's lowest bending mode.
     pub fn hum_hz(&self, material: &Material) -> f64 {
-        let radius_m = 0.5 * self.diameter_m;
-        let radius_of_gyration_m = self.thickness_m / 12f64.sqrt();
-        radius_of_gyration_m * material.rod_wave_speed_m_per_s() / (TAU * radius_m * radius_m)
-            * RING_MODE_2_FACTOR
+        super::bowl::ring_bending_hz(material, self.diameter_m, self.thickness_m, 2)
     }
 
     /// Prime (strike note of a tuned bell) in Hz.

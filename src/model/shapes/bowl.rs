@@ -47,16 +47,9 @@ pub struct Bowl {
 }
 
 impl Bowl {
-    /// Frequency of the mode with `m` waves around the rim, Hz (of the pair's lower one before
-    /// the split).
+    /// Frequency of the mode with `m` waves around the rim, Hz (before the pair's split).
     fn ring_hz(&self, material: &Material, m: u32) -> f64 {
-        let radius_m = 0.5 * self.diameter_m;
-        let radius_of_gyration_m = self.thickness_m / 12f64.sqrt();
-        let m = f64::from(m);
-        radius_of_gyration_m * material.rod_wave_speed_m_per_s() / (TAU * radius_m * radius_m)
-            * m
-            * (m * m - 1.0)
-            / (m * m + 1.0).sqrt()
+        ring_bending_hz(material, self.diameter_m, self.thickness_m, m)
     }
 
     /// The lowest mode, (2, 0), in Hz: the pitch a bowl sings at.
@@ -107,6 +100,19 @@ impl Bowl {
         }
         modes
     }
+}
+
+/// The in-plane bending mode with `m` waves round a thin ring of `diameter_m` and
+/// `thickness_m`, Hz: `(1 / 2 pi) sqrt(E / (12 rho)) (h / R^2) m (m^2 - 1) / sqrt(m^2 + 1)`
+/// (Hoppe 1871).
+pub fn ring_bending_hz(material: &Material, diameter_m: f64, thickness_m: f64, m: u32) -> f64 {
+    let radius_m = 0.5 * diameter_m;
+    let radius_of_gyration_m = thickness_m / 12f64.sqrt();
+    let m = f64::from(m);
+    radius_of_gyration_m * material.rod_wave_speed_m_per_s() / (TAU * radius_m * radius_m)
+        * m
+        * (m * m - 1.0)
+        / (m * m + 1.0).sqrt()
 }
 
 /// Radial displacement of the mode with `m` waves at `s` along the wall (0 base, 1 rim), 1 at
