@@ -9,6 +9,7 @@ pub mod fit;
 pub mod io;
 pub mod limen;
 pub mod materials;
+pub mod mesh;
 pub mod schema;
 pub mod shapes;
 pub mod staged;

@@ -17,7 +17,7 @@ const DRUM_STICK_MS: f64 = 1.5;
 /// Mallet contact time for a solid object of each material class, in ms: a hard mallet on metal
 /// or glass makes a contact of a few tenths of a millisecond; the yarn and rubber mallets used on
 /// wooden bars, and soft plastics, make longer, duller contacts.
-fn solid_contact_ms(class: MaterialClass) -> f64 {
+pub(crate) fn solid_contact_ms(class: MaterialClass) -> f64 {
     match class {
         MaterialClass::Metal => 0.3,
         MaterialClass::GlassCeramic => 0.25,

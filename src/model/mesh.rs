@@ -1,0 +1,424 @@
+//! Banks from 3-D models: the modes of a solid bounded by a closed triangle surface, by finite
+//! elements on voxels (seed 000 sections 3.2 and 3.2.3).
+//!
+//! The pipeline: the surface is checked ([`Surface::check`]), filled with cubes of one size
+//! ([`voxel::voxelize`]), each cube an 8-node brick of linear elasticity with incompatible
+//! bending modes ([`element`]); their stiffness and mass are assembled sparse ([`assemble`]),
+//! and the lowest modes of `K phi = omega^2 M phi` come from shift-invert Lanczos on a sparse
+//! Cholesky factorisation ([`lanczos`]). Rigid motions of a free object are found and left out.
+//! A mode's gain at a strike point is its mass-normalised shape along the surface normal there,
+//! over `omega` (seed 000 eq. 3.11, as the analytic shapes do); decays come from the material.
+//!
+//! Voxels rather than tetrahedra: any closed surface fills without a mesher that can fail on
+//! it, every element is the same box (its matrices are computed once), and the incompatible
+//! modes keep a few bricks through a thin wall from locking in bending. The price is a
+//! staircase at curved surfaces, which refining the grid removes.
+
+pub mod assemble;
+pub mod element;
+pub mod generate;
+pub mod lanczos;
+pub mod read;
+pub mod surface;
+pub mod voxel;
+
+use std::fmt;
+use std::time::{Duration, Instant};
+
+pub use lanczos::SolveStage;
+pub use read::{parse_surface, write_obj};
+pub use surface::Surface;
+pub use voxel::Voxels;
+
+use crate::model::materials::Material;
+
+/// Default number of solid voxels: 100 modes of it solve in seconds.
+pub const DEFAULT_ELEMENTS: usize = 20_000;
+
+/// The Lanczos shift, `-(2 pi 20 Hz)^2`: below every audible mode and below the rigid motions'
+/// zero, so `K - sigma M` is positive definite.
+const SHIFT_HZ: f64 = 20.0;
+
+/// Modes below this frequency are rigid motions (numerically zero), not vibrations.
+const RIGID_HZ: f64 = 1.0;
+
+/// Rigid motions of a free solid: three translations, three rotations.
+const RIGID_MOTIONS: usize = 6;
+
+/// Why a mesh could not be made into modes.
+#[derive(Debug, Clone, PartialEq)]
+pub enum MeshError {
+    /// The file cannot be read as a mesh.
+    Syntax {
+        /// Line (OBJ, ASCII STL) or triangle (binary STL), from 1.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// No triangles.
+    Empty,
+    /// A face refers to a vertex that does not exist.
+    BadIndex {
+        /// Face index, from 0.
+        face: usize,
+        /// The vertex index it names.
+        vertex: usize,
+        /// Number of vertices.
+        count: usize,
+    },
+    /// A triangle without area.
+    Degenerate {
+        /// Face index.
+        face: usize,
+        /// Its vertices.
+        vertices: [u32; 3],
+    },
+    /// An edge with a triangle on one side only: the surface has a hole.
+    Open {
+        /// The face with the edge.
+        face: usize,
+        /// The edge's vertices.
+        edge: [u32; 2],
+    },
+    /// An edge shared by more than two triangles.
+    NonManifold {
+        /// The faces sharing it.
+        faces: Vec<usize>,
+        /// The edge's vertices.
+        edge: [u32; 2],
+    },
+    /// Two neighbouring triangles facing opposite ways.
+    Inconsistent {
+        /// The two faces.
+        faces: [usize; 2],
+        /// Their shared edge.
+        edge: [u32; 2],
+    },
+    /// The triangles face inward.
+    InsideOut {
+        /// The signed volume, negative.
+        volume_m3: f64,
+    },
+    /// More triangles, cells or elements than can be solved.
+    TooLarge {
+        /// What there are too many of.
+        what: &'static str,
+        /// How many.
+        count: usize,
+        /// The limit.
+        limit: usize,
+    },
+    /// No voxel centre falls inside the surface.
+    TooThin {
+        /// Voxel edge in metres.
+        voxel_m: f64,
+    },
+    /// The voxels fall apart into several pieces.
+    Pieces {
+        /// How many.
+        pieces: usize,
+        /// Voxel edge in metres.
+        voxel_m: f64,
+    },
+    /// A setting is out of range.
+    BadSetting {
+        /// Its name.
+        name: &'static str,
+        /// What was expected.
+        reason: String,
+    },
+    /// The eigensolver failed.
+    Solver(String),
+    /// No elastic mode lies below the frequency limit.
+    NoModes {
+        /// The limit in Hz.
+        max_freq_hz: f64,
+    },
+}
+
+impl fmt::Display for MeshError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Syntax { line, message } => write!(f, "line {line}: {message}"),
+            Self::Empty => write!(f, "the mesh has no faces"),
+            Self::BadIndex { face, vertex, count } => write!(
+                f,
+                "face {face} names vertex {vertex}, but there are only {count} vertices"
+            ),
+            Self::Degenerate { face, vertices } => write!(
+                f,
+                "face {face} (vertices {vertices:?}) has no area: remove degenerate triangles"
+            ),
+            Self::Open { face, edge } => write!(
+                f,
+                "the surface is not closed: edge {edge:?} of face {face} borders no other face \
+                 (a hole); a solid needs a watertight surface"
+            ),
+            Self::NonManifold { faces, edge } => write!(
+                f,
+                "the surface is not manifold: edge {edge:?} is shared by {} faces {faces:?}, \
+                 expected 2",
+                faces.len()
+            ),
+            Self::Inconsistent { faces, edge } => write!(
+                f,
+                "faces {} and {} face opposite ways across edge {edge:?}: orient every face \
+                 counter-clockwise seen from outside",
+                faces[0], faces[1]
+            ),
+            Self::InsideOut { volume_m3 } => write!(
+                f,
+                "the surface is inside-out (its faces point inward, signed volume {volume_m3:.3e} \
+                 m^3): flip the normals"
+            ),
+            Self::TooLarge { what, count, limit } => write!(
+                f,
+                "too large: {count} {what}, at most {limit}; use fewer elements or a coarser mesh"
+            ),
+            Self::TooThin { voxel_m } => write!(
+                f,
+                "no voxel of {:.3} mm fits inside the surface: the object is thinner than a voxel; \
+                 use more elements",
+                voxel_m * 1e3
+            ),
+            Self::Pieces { pieces, voxel_m } => write!(
+                f,
+                "at voxels of {:.3} mm the object falls apart into {pieces} pieces: a wall or \
+                 a joint is thinner than a voxel (or the mesh holds separate objects); use more \
+                 elements",
+                voxel_m * 1e3
+            ),
+            Self::BadSetting { name, reason } => write!(f, "{name}: {reason}"),
+            Self::Solver(reason) => write!(f, "the eigensolver failed: {reason}"),
+            Self::NoModes { max_freq_hz } => {
+                write!(f, "no mode below {max_freq_hz} Hz: the object is too small or too stiff")
+            }
+        }
+    }
+}
+
+impl std::error::Error for MeshError {}
+
+/// A region of the solid held still.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Clamp {
+    /// Everything at or below `at_m` along `axis` (0 = x, 1 = y, 2 = z).
+    Below {
+        /// The axis.
+        axis: usize,
+        /// The plane's coordinate in metres.
+        at_m: f64,
+    },
+    /// Everything at or above `at_m` along `axis`.
+    Above {
+        /// The axis.
+        axis: usize,
+        /// The plane's coordinate in metres.
+        at_m: f64,
+    },
+    /// The grid corners within one voxel of a point (a mesh vertex, say).
+    Near {
+        /// The point in metres.
+        point_m: [f64; 3],
+    },
+}
+
+impl Clamp {
+    /// Whether a grid corner at `p` is held, for voxels of edge `voxel_m`.
+    fn holds(&self, p: [f64; 3], voxel_m: f64) -> bool {
+        let tolerance = 1e-6 * voxel_m;
+        match *self {
+            Self::Below { axis, at_m } => p[axis] <= at_m + tolerance,
+            Self::Above { axis, at_m } => p[axis] >= at_m - tolerance,
+            Self::Near { point_m } => surface::norm(surface::sub(p, point_m)) <= voxel_m,
+        }
+    }
+}
+
+/// How a surface is made into modes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshSettings {
+    /// What the solid is made of.
+    pub material: Material,
+    /// Number of voxels to aim for (the voxel edge is chosen from the volume).
+    pub elements: usize,
+    /// Regions held still; none for a free object.
+    pub clamps: Vec<Clamp>,
+    /// Number of vibration modes to find (the lowest).
+    pub modes: usize,
+}
+
+/// How long each stage took and how large the problem was.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SolveStats {
+    /// Solid voxels (elements).
+    pub elements: usize,
+    /// Longest edge of a voxel in metres.
+    pub voxel_m: f64,
+    /// Free degrees of freedom.
+    pub dofs: usize,
+    /// Stored entries of the stiffness matrix's lower triangle.
+    pub matrix_entries: usize,
+    /// Entries of the Cholesky factor.
+    pub factor_entries: usize,
+    /// Lanczos steps.
+    pub steps: usize,
+    /// Rigid motions found and left out.
+    pub rigid_modes: usize,
+    /// Time to fill the surface with voxels.
+    pub voxelising: Duration,
+    /// Time to assemble the matrices.
+    pub assembling: Duration,
+    /// Time to factorise and iterate.
+    pub solving: Duration,
+}
+
+/// What the solver reports as it goes, for progress bars.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MeshStage {
+    /// Filling the surface with voxels.
+    Voxelising,
+    /// Assembling stiffness and mass.
+    Assembling {
+        /// Elements.
+        elements: usize,
+    },
+    /// The solver's own stages.
+    Solving(SolveStage),
+}
+
+/// The vibration modes of a meshed solid.
+#[derive(Debug, Clone)]
+pub struct MeshModes {
+    /// The voxels the modes live on.
+    pub voxels: Voxels,
+    /// Degree of freedom of each grid corner (see [`assemble::System::corner_dof`]).
+    corner_dof: Vec<Option<usize>>,
+    /// Frequencies in Hz, ascending, rigid motions left out.
+    pub freqs_hz: Vec<f64>,
+    /// Mass-normalised mode shapes over the free degrees of freedom, one per frequency.
+    shapes: Vec<Vec<f64>>,
+    /// Sizes and times.
+    pub stats: SolveStats,
+}
+
+/// The lowest vibration modes of the solid bounded by `surface` (checked here).
+pub fn solve_modes(
+    surface: &Surface,
+    settings: &MeshSettings,
+    progress: &mut dyn FnMut(MeshStage),
+) -> Result<MeshModes, MeshError> {
+    surface.check()?;
+    if settings.modes == 0 {
+        return Err(MeshError::BadSetting {
+            name: "modes",
+            reason: "expected at least 1".to_string(),
+        });
+    }
+    if settings.elements < 8 {
+        return Err(MeshError::BadSetting {
+            name: "elements",
+            reason: format!("expected at least 8, found {}", settings.elements),
+        });
+    }
+    let started = Instant::now();
+    progress(MeshStage::Voxelising);
+    let voxel_m = (surface.signed_volume_m3() / settings.elements as f64).cbrt();
+    let voxels = voxel::voxelize(surface, voxel_m)?;
+    let pieces = voxels.pieces();
+    if pieces > 1 {
+        return Err(MeshError::Pieces { pieces, voxel_m });
+    }
+    let mut stats = SolveStats {
+        elements: voxels.count(),
+        voxel_m: voxels.size_m.iter().fold(0.0, |a, &b| f64::max(a, b)),
+        voxelising: started.elapsed(),
+        ..SolveStats::default()
+    };
+
+    let started = Instant::now();
+    progress(MeshStage::Assembling {
+        elements: stats.elements,
+    });
+    let m = &settings.material;
+    let brick = element::brick_matrices(
+        voxels.size_m,
+        m.density_kg_m3,
+        m.youngs_modulus_pa,
+        m.poisson_ratio,
+    );
+    let system = assemble::assemble(&voxels, &brick, |p| {
+        settings.clamps.iter().any(|c| c.holds(p, voxel_m))
+    });
+    stats.dofs = system.dofs;
+    stats.matrix_entries = system.entries();
+    stats.assembling = started.elapsed();
+
+    let started = Instant::now();
+    let shift = -(std::f64::consts::TAU * SHIFT_HZ).powi(2);
+    let pairs = lanczos::lowest_eigenpairs(
+        &system,
+        settings.modes + RIGID_MOTIONS,
+        shift,
+        &mut |stage| progress(MeshStage::Solving(stage)),
+    )?;
+    stats.solving = started.elapsed();
+    stats.factor_entries = pairs.factor_entries;
+    stats.steps = pairs.steps;
+
+    let rigid_limit = (std::f64::consts::TAU * RIGID_HZ).powi(2);
+    let mut freqs_hz = Vec::new();
+    let mut shapes = Vec::new();
+    for (value, vector) in pairs.values.into_iter().zip(pairs.vectors) {
+        if value < rigid_limit {
+            stats.rigid_modes += 1;
+        } else if freqs_hz.len() < settings.modes {
+            freqs_hz.push(value.sqrt() / std::f64::consts::TAU);
+            shapes.push(vector);
+        }
+    }
+    Ok(MeshModes {
+        voxels,
+        corner_dof: system.corner_dof,
+        freqs_hz,
+        shapes,
+        stats,
+    })
+}
+
+impl MeshModes {
+    /// Each mode's displacement at `point_m` (on or near the solid) along the unit vector
+    /// `direction`, from the voxel nearest the point (trilinear between its corners).
+    pub fn displacement_along(&self, point_m: [f64; 3], direction: [f64; 3]) -> Vec<f64> {
+        let v = &self.voxels;
+        let Some(cell) = v.nearest_solid(point_m) else {
+            return vec![0.0; self.freqs_hz.len()];
+        };
+        let corner = v.corner_m(cell);
+        let t = [0, 1, 2].map(|a| ((point_m[a] - corner[a]) / v.size_m[a]).clamp(0.0, 1.0));
+        let (cx, cy) = (v.dims[0] + 1, v.dims[1] + 1);
+        let mut weights: Vec<(usize, f64)> = Vec::with_capacity(8);
+        for c in 0..8 {
+            let offset = [c & 1, c >> 1 & 1, c >> 2 & 1];
+            let index = (cell[0] + offset[0])
+                + cx * ((cell[1] + offset[1]) + cy * (cell[2] + offset[2]));
+            let w: f64 = (0..3)
+                .map(|a| if offset[a] == 1 { t[a] } else { 1.0 - t[a] })
+                .product();
+            if let Some(dof) = self.corner_dof[index] {
+                weights.push((dof, w));
+            }
+        }
+        self.shapes
+            .iter()
+            .map(|shape| {
+                weights
+                    .iter()
+                    .map(|&(dof, w)| {
+                        w * (0..3).map(|a| shape[dof + a] * direction[a]).sum::<f64>()
+                    })
+                    .sum()
+            })
+            .collect()
+    }
+}

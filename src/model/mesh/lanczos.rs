@@ -1,0 +1,237 @@
+//! The lowest modes of `K phi = lambda M phi`: shift-invert Lanczos with full
+//! reorthogonalisation on a sparse Cholesky factorisation of `K - sigma M`.
+//!
+//! The operator `(K - sigma M)^-1 M` is symmetric in the `M` inner product and has eigenvalues
+//! `theta = 1 / (lambda - sigma)`: the modes nearest above the shift become its largest, which
+//! Lanczos finds first (Ericsson and Ruhe, "The spectral transformation Lanczos method", 1980).
+//! With a shift below zero, `K - sigma M` is positive definite even for a free object, whose six
+//! rigid motions (`lambda = 0`) come out first and are left out by the caller.
+
+use faer::linalg::solvers::Solve;
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::{ColRef, MatRef, Side};
+
+use super::assemble::System;
+use super::MeshError;
+
+/// A Ritz pair is converged when its residual is below this share of its eigenvalue.
+const TOLERANCE: f64 = 1e-9;
+
+/// Lanczos steps taken before the first convergence check, beyond the modes asked for.
+const EXTRA_STEPS: usize = 40;
+
+/// Steps added between convergence checks.
+const CHECK_EVERY: usize = 20;
+
+/// What the solver reports as it goes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SolveStage {
+    /// Factorising `K - sigma M`, with its stored entries (lower triangle).
+    Factorising,
+    /// Lanczos steps taken so far, of a first estimate of those needed.
+    Iterating {
+        /// Steps taken.
+        steps: usize,
+        /// Steps expected.
+        expected: usize,
+    },
+}
+
+/// Eigenpairs from the bottom of the spectrum.
+#[derive(Debug, Clone)]
+pub struct Eigenpairs {
+    /// Eigenvalues `omega^2` in (rad/s)^2, ascending.
+    pub values: Vec<f64>,
+    /// Eigenvectors, `M`-normalised (`phi^T M phi = 1`), one per value.
+    pub vectors: Vec<Vec<f64>>,
+    /// Lanczos steps taken.
+    pub steps: usize,
+    /// Non-zero entries of the Cholesky factor.
+    pub factor_entries: usize,
+}
+
+/// The `count` lowest eigenpairs of `system` above `shift` (in (rad/s)^2; below every eigenvalue
+/// wanted, and below zero for a free object).
+pub fn lowest_eigenpairs(
+    system: &System,
+    count: usize,
+    shift: f64,
+    progress: &mut dyn FnMut(SolveStage),
+) -> Result<Eigenpairs, MeshError> {
+    let n = system.dofs;
+    let count = count.min(n);
+    if count == 0 {
+        return Err(MeshError::Solver("no degree of freedom is free".to_string()));
+    }
+    progress(SolveStage::Factorising);
+    let shifted: Vec<f64> = system
+        .stiffness
+        .iter()
+        .zip(&system.mass)
+        .map(|(k, m)| k - shift * m)
+        .collect();
+    let symbolic = SymbolicSparseColMatRef::new_checked(n, n, &system.col_ptr, None, &system.rows);
+    let matrix = SparseColMatRef::new(symbolic, &shifted);
+    let factor = matrix.sp_cholesky(Side::Lower).map_err(|e| {
+        MeshError::Solver(format!(
+            "K - sigma M is not positive definite ({e:?}): the mesh may hold a mechanism"
+        ))
+    })?;
+    // The factor's size, for the report (the symbolic analysis again: the solver keeps its own).
+    let factor_entries = faer::sparse::linalg::cholesky::factorize_symbolic_cholesky(
+        symbolic,
+        Side::Lower,
+        Default::default(),
+        Default::default(),
+    )
+    .map(|s| s.len_val())
+    .unwrap_or(0);
+    drop(shifted);
+
+    let max_steps = n;
+    let mut expected = (2 * count + EXTRA_STEPS).min(max_steps);
+    let mut basis: Vec<f64> = Vec::with_capacity(n * expected);
+    let mut alpha: Vec<f64> = Vec::new();
+    let mut beta: Vec<f64> = Vec::new();
+    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+    let mut w = random_vector(n, &mut seed);
+    let mut mw = vec![0.0; n];
+    let mut next_check = expected.min(count + EXTRA_STEPS);
+    loop {
+        let steps = alpha.len();
+        // Normalise w into the next basis vector (restarting if the last step broke down: w
+        // then lies in the span of the basis, an invariant subspace).
+        if steps == 0 {
+            system.mass_times(&w, &mut mw);
+        }
+        let mut b = m_norm(&w, &mw);
+        let scale = alpha.iter().fold(0.0f64, |s, a| s.max(a.abs()));
+        if steps > 0 && b <= 1e-12 * scale {
+            w = random_vector(n, &mut seed);
+            orthogonalise(&basis, n, system, &mut w, &mut mw);
+            b = m_norm(&w, &mw);
+            if steps > 0 {
+                *beta.last_mut().expect("a step") = 0.0;
+            }
+        }
+        let q: Vec<f64> = w.iter().map(|x| x / b).collect();
+        let mq: Vec<f64> = mw.iter().map(|x| x / b).collect();
+        basis.extend_from_slice(&q);
+        // w = (K - sigma M)^-1 M q
+        w.copy_from_slice(&mq);
+        factor.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut w, n, 1));
+        let a: f64 = mq.iter().zip(&w).map(|(m, w)| m * w).sum();
+        alpha.push(a);
+        system.mass_times(&w, &mut mw);
+        // beta_j is computed once w is orthogonal to the basis, at the next step's start.
+        orthogonalise(&basis, n, system, &mut w, &mut mw);
+        beta.push(m_norm(&w, &mw));
+        let steps = alpha.len();
+        progress(SolveStage::Iterating { steps, expected });
+        if steps >= next_check || steps == max_steps {
+            if let Some(pairs) = converged(&alpha, &beta, count, steps == max_steps)? {
+                let vectors = ritz_vectors(&basis, n, &pairs.1);
+                return Ok(Eigenpairs {
+                    values: pairs.0.iter().map(|theta| shift + 1.0 / theta).collect(),
+                    vectors,
+                    steps,
+                    factor_entries,
+                });
+            }
+            next_check = (steps + CHECK_EVERY).min(max_steps);
+            expected = expected.max(next_check);
+        }
+    }
+}
+
+/// `sqrt(w^T M w)` from `w` and `M w`.
+fn m_norm(w: &[f64], mw: &[f64]) -> f64 {
+    w.iter().zip(mw).map(|(a, b)| a * b).sum::<f64>().max(0.0).sqrt()
+}
+
+/// A deterministic pseudo-random vector (xorshift), so solves repeat exactly.
+fn random_vector(n: usize, seed: &mut u64) -> Vec<f64> {
+    (0..n)
+        .map(|_| {
+            *seed ^= *seed << 13;
+            *seed ^= *seed >> 7;
+            *seed ^= *seed << 17;
+            (*seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        })
+        .collect()
+}
+
+/// Removes from `w` its `M`-projection on every basis vector, twice (classical Gram-Schmidt
+/// repeated: "twice is enough"), and leaves `M w` in `mw`.
+fn orthogonalise(basis: &[f64], n: usize, system: &System, w: &mut [f64], mw: &mut [f64]) {
+    let j = basis.len() / n;
+    system.mass_times(w, mw);
+    if j == 0 {
+        return;
+    }
+    let q = MatRef::from_column_major_slice(basis, n, j);
+    for _ in 0..2 {
+        let c = q.transpose() * ColRef::from_slice(mw);
+        let correction = q * &c;
+        for (x, d) in w.iter_mut().zip(correction.iter()) {
+            *x -= d;
+        }
+        system.mass_times(w, mw);
+    }
+}
+
+/// The `count` largest Ritz values of the tridiagonal `(alpha, beta)` and their vectors in the
+/// Lanczos basis, once all of them are converged (or `last`, when the basis is complete).
+#[allow(clippy::type_complexity)]
+fn converged(
+    alpha: &[f64],
+    beta: &[f64],
+    count: usize,
+    last: bool,
+) -> Result<Option<(Vec<f64>, Vec<Vec<f64>>)>, MeshError> {
+    let m = alpha.len();
+    let t = faer::Mat::from_fn(m, m, |i, j| {
+        if i == j {
+            alpha[i]
+        } else if i == j + 1 {
+            beta[j]
+        } else if j == i + 1 {
+            beta[i]
+        } else {
+            0.0
+        }
+    });
+    let eigen = t
+        .self_adjoint_eigen(Side::Lower)
+        .map_err(|e| MeshError::Solver(format!("tridiagonal eigenproblem failed: {e:?}")))?;
+    let (values, vectors) = (eigen.S(), eigen.U());
+    let residual_scale = beta[m - 1];
+    let mut thetas = Vec::with_capacity(count);
+    let mut ritz = Vec::with_capacity(count);
+    // Ascending eigenvalues: the largest thetas are the lowest modes.
+    for i in (0..m).rev().take(count) {
+        let theta = values[i];
+        let residual = (residual_scale * vectors[(m - 1, i)]).abs();
+        if !last && residual > TOLERANCE * theta.abs() {
+            return Ok(None);
+        }
+        thetas.push(theta);
+        ritz.push((0..m).map(|k| vectors[(k, i)]).collect());
+    }
+    Ok(Some((thetas, ritz)))
+}
+
+/// `Q s` for each Ritz vector `s` in the basis `Q` (columns of length `n`).
+fn ritz_vectors(basis: &[f64], n: usize, ritz: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    ritz.iter()
+        .map(|s| {
+            let mut x = vec![0.0; n];
+            for (k, &sk) in s.iter().enumerate() {
+                for (xi, qi) in x.iter_mut().zip(&basis[k * n..(k + 1) * n]) {
+                    *xi += sk * qi;
+                }
+            }
+            x
+        })
+        .collect()
+}
