@@ -448,13 +448,26 @@ fn mixed_one_and_two_dimensional_coords() {
 }
 
 #[test]
-fn three_dimensional_coords() {
-    let error = load_bad("coords-3d.json");
+fn four_dimensional_coords() {
+    let error = load_bad("coords-4d.json");
     assert_only_problem(
         &error,
         "positions[0].coords",
-        "found 3 coordinates, expected 1 (a point along a line) or 2 (a point on a surface)",
+        "found 4 coordinates, expected 1 (a point along a line), 2 (a point on a surface) or 3 \
+         (a point in space)",
     );
+}
+
+#[test]
+fn points_in_space_are_positions() {
+    let text = r#"{
+        "format": "modal-bank", "version": 1, "name": "Cup",
+        "positions": [{"name": "rim", "coords": [0.04, 0.0, 0.09]},
+                      {"name": "base", "coords": [0.0, 0.0, 0.0]}],
+        "modes": [{"freq_hz": 1200, "decay_per_s": 2.0, "gains": [1.0, 0.2]}]
+    }"#;
+    let bank = modal_resonator::model::parse_bank_str(text, "cup.json").expect("a 3-D bank loads");
+    assert_eq!(bank.positions[0].coords, vec![0.04, 0.0, 0.09]);
 }
 
 #[test]

@@ -671,7 +671,7 @@ fn play_help_lists_the_standalone_options() {
 
 /// The broken banks of the format tests, each with the JSON path (or position) its error names.
 const BROKEN: &[(&str, &str)] = &[
-    ("coords-3d.json", "positions[0].coords"),
+    ("coords-4d.json", "positions[0].coords"),
     ("duplicate-position-names.json", "positions[2].name"),
     ("huge-number-1e300.json", "modes[0].freq_hz"),
     ("huge-number-1e400.json", "out of range"),

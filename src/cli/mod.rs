@@ -5,6 +5,7 @@ mod compress;
 mod fit;
 mod info;
 mod list;
+mod mesh;
 mod play;
 mod progress;
 mod render;
@@ -48,6 +49,9 @@ enum Command {
     /// Make a bank from an analytic object (string, bar, tine, membrane, plate, disc, bell) of
     /// given dimensions and material.
     Shape(Box<shape::ShapeArgs>),
+    /// Make a bank from a 3-D model (closed OBJ or STL surface) by finite elements: its lowest
+    /// modes, decays from the material, gains at strike points on the surface.
+    Mesh(Box<mesh::MeshArgs>),
     /// Make a bank cheaper: merge modes closer than the frequency difference limen and drop
     /// modes far below the strongest.
     Compress(compress::CompressArgs),
@@ -98,6 +102,7 @@ pub fn main() -> ExitCode {
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Fit(args)) => fit::run(&args).map(|()| ExitCode::SUCCESS),
         Some(Command::Shape(args)) => shape::run(&args).map(|()| ExitCode::SUCCESS),
+        Some(Command::Mesh(args)) => mesh::run(&args).map(|()| ExitCode::SUCCESS),
         Some(Command::Compress(args)) => compress::run(&args).map(|()| ExitCode::SUCCESS),
         Some(Command::Validate { files }) => validate::run(&files).map(|()| ExitCode::SUCCESS),
         Some(Command::Info { bank }) => info::run(&bank).map(|()| ExitCode::SUCCESS),

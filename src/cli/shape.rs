@@ -211,7 +211,7 @@ fn parse_object(text: &str) -> Result<&'static ObjectKind, String> {
 }
 
 /// Parses `--material`.
-fn parse_material(text: &str) -> Result<&'static Material, String> {
+pub(super) fn parse_material(text: &str) -> Result<&'static Material, String> {
     Material::by_name(text).ok_or_else(|| {
         format!(
             "unknown material \"{text}\": expected one of {}",
@@ -221,7 +221,7 @@ fn parse_material(text: &str) -> Result<&'static Material, String> {
 }
 
 /// Parses a positive finite number.
-fn parse_positive(text: &str) -> Result<f64, String> {
+pub(super) fn parse_positive(text: &str) -> Result<f64, String> {
     text.trim()
         .parse::<f64>()
         .ok()

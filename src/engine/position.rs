@@ -78,8 +78,18 @@ impl StrikeAxis {
 }
 
 impl PositionMap {
-    /// The map of positions with coordinates `coords` (each 1 or 2 values): see [`PositionMap`].
+    /// The map of positions with coordinates `coords` (each 1, 2 or 3 values): see
+    /// [`PositionMap`]. Points in space (3 values: on the surface of a meshed object) are seen
+    /// in the plane of their two widest spreads, each axis stretched over 0 to 1.
     pub fn new(coords: &[Vec<f64>]) -> Self {
+        let spatial = coords.iter().any(|c| c.len() >= 3);
+        let projected;
+        let coords = if spatial {
+            projected = project_onto_widest_plane(coords);
+            &projected[..]
+        } else {
+            coords
+        };
         let dims = coords
             .iter()
             .map(|c| c.len())
@@ -97,6 +107,8 @@ impl PositionMap {
                 });
             axes[axis] = if hi <= lo {
                 StrikeAxis::Fixed
+            } else if spatial {
+                StrikeAxis::Stretched { lo, hi }
             } else if lo >= 0.0 && hi <= 0.5 {
                 StrikeAxis::Mirrored
             } else if lo >= 0.0 && hi <= 1.0 {
@@ -265,6 +277,76 @@ impl PositionMap {
     }
 }
 
+/// Points in space seen in the plane of their two widest spreads (the principal axes of their
+/// scatter, the widest first), as 2-D coordinates from their mean.
+fn project_onto_widest_plane(coords: &[Vec<f64>]) -> Vec<Vec<f64>> {
+    let point = |c: &Vec<f64>| [0, 1, 2].map(|a| c.get(a).copied().unwrap_or(0.0));
+    let n = coords.len().max(1) as f64;
+    let mean = coords.iter().fold([0.0; 3], |m, c| {
+        let p = point(c);
+        [m[0] + p[0] / n, m[1] + p[1] / n, m[2] + p[2] / n]
+    });
+    let mut scatter = [[0.0; 3]; 3];
+    for c in coords {
+        let p = point(c);
+        for i in 0..3 {
+            for j in 0..3 {
+                scatter[i][j] += (p[i] - mean[i]) * (p[j] - mean[j]);
+            }
+        }
+    }
+    let (values, vectors) = symmetric_eigen3(scatter);
+    let mut order = [0, 1, 2];
+    order.sort_by(|&a, &b| values[b].total_cmp(&values[a]));
+    coords
+        .iter()
+        .map(|c| {
+            let p = point(c);
+            order[..2]
+                .iter()
+                .map(|&k| (0..3).map(|a| (p[a] - mean[a]) * vectors[a][k]).sum())
+                .collect()
+        })
+        .collect()
+}
+
+/// Eigenvalues and eigenvectors (columns) of a symmetric 3 x 3 matrix, by Jacobi rotations.
+fn symmetric_eigen3(mut a: [[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
+    let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    for _ in 0..50 {
+        let off = a[0][1].abs() + a[0][2].abs() + a[1][2].abs();
+        let scale = a[0][0].abs() + a[1][1].abs() + a[2][2].abs();
+        if off <= 1e-15 * scale || off == 0.0 {
+            break;
+        }
+        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
+            if a[p][q] == 0.0 {
+                continue;
+            }
+            let theta = 0.5 * (a[q][q] - a[p][p]) / a[p][q];
+            let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+            let t = if theta == 0.0 { 1.0 } else { t };
+            let (c, s) = (1.0 / (t * t + 1.0).sqrt(), t / (t * t + 1.0).sqrt());
+            for row in a.iter_mut() {
+                let (akp, akq) = (row[p], row[q]);
+                row[p] = c * akp - s * akq;
+                row[q] = s * akp + c * akq;
+            }
+            let (row_p, row_q) = (a[p], a[q]);
+            for k in 0..3 {
+                a[p][k] = c * row_p[k] - s * row_q[k];
+                a[q][k] = s * row_p[k] + c * row_q[k];
+            }
+            for row in v.iter_mut() {
+                let (vp, vq) = (row[p], row[q]);
+                row[p] = c * vp - s * vq;
+                row[q] = s * vp + c * vq;
+            }
+        }
+    }
+    ([a[0][0], a[1][1], a[2][2]], v)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -308,6 +390,44 @@ mod tests {
         let map = PositionMap::new(&[vec![0.625, 0.0], vec![0.0, 0.0], vec![0.875, 0.0]]);
         assert_eq!(map.axes(), [StrikeAxis::Object, StrikeAxis::Fixed]);
         assert_eq!(map.weights(0.625, 0.3), PositionWeights::single(0));
+    }
+
+    #[test]
+    fn points_in_space_are_seen_in_their_widest_plane() {
+        // Four points on a tilted square (side 0.1 m, in the plane z = y), and one off it.
+        let map = PositionMap::new(&[
+            vec![0.0, 0.0, 0.0],
+            vec![0.1, 0.0, 0.0],
+            vec![0.0, 0.07, 0.07],
+            vec![0.1, 0.07, 0.07],
+            vec![0.05, 0.035, 0.037],
+        ]);
+        assert_eq!(map.dims(), 2);
+        assert!(map.moves_along(0) && map.moves_along(1));
+        assert!(matches!(map.axes()[0], StrikeAxis::Stretched { .. }));
+        // The square's corners land on the pad's corners, the fifth point in the middle.
+        let mut corners: Vec<[i64; 2]> = map.coords()[..4]
+            .iter()
+            .map(|c| [c[0].round() as i64, c[1].round() as i64])
+            .collect();
+        corners.sort();
+        assert_eq!(
+            corners,
+            vec![[0, 0], [0, 1], [1, 0], [1, 1]],
+            "{:?}",
+            map.coords()
+        );
+        let middle = map.coords()[4];
+        assert!(
+            (middle[0] - 0.5).abs() < 0.01 && (middle[1] - 0.5).abs() < 0.01,
+            "{middle:?}"
+        );
+        for (k, c) in map.coords().iter().enumerate() {
+            assert_eq!(
+                map.weights(c[0] as f32, c[1] as f32),
+                PositionWeights::single(k)
+            );
+        }
     }
 
     #[test]

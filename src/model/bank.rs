@@ -61,9 +61,10 @@ pub struct Position {
     /// Display name, for example "edge" or "centre".
     #[schemars(length(min = 1))]
     pub name: String,
-    /// Coordinates on the object: one value (along a line) or two (on a surface), in any unit
-    /// consistent within the bank (usually fractions of the object's length).
-    #[schemars(length(min = 1, max = 2))]
+    /// Coordinates on the object: one value (along a line), two (on a surface) or three (a
+    /// point in space, on the surface of a meshed object, in metres), in any unit consistent
+    /// within the bank (usually fractions of the object's length).
+    #[schemars(length(min = 1, max = 3))]
     pub coords: Vec<f64>,
 }
 

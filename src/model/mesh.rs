@@ -20,6 +20,7 @@ pub mod generate;
 pub mod lanczos;
 pub mod read;
 pub mod surface;
+pub mod to_bank;
 pub mod voxel;
 
 use std::fmt;
@@ -28,6 +29,9 @@ use std::time::{Duration, Instant};
 pub use lanczos::SolveStage;
 pub use read::{parse_surface, write_obj};
 pub use surface::Surface;
+pub use to_bank::{
+    bank_from_modes, spread_strike_points, strike_points, MeshSource, StrikePoint, StrikeRequest,
+};
 pub use voxel::Voxels;
 
 use crate::model::materials::Material;
@@ -141,7 +145,11 @@ impl fmt::Display for MeshError {
         match self {
             Self::Syntax { line, message } => write!(f, "line {line}: {message}"),
             Self::Empty => write!(f, "the mesh has no faces"),
-            Self::BadIndex { face, vertex, count } => write!(
+            Self::BadIndex {
+                face,
+                vertex,
+                count,
+            } => write!(
                 f,
                 "face {face} names vertex {vertex}, but there are only {count} vertices"
             ),
@@ -191,7 +199,10 @@ impl fmt::Display for MeshError {
             Self::BadSetting { name, reason } => write!(f, "{name}: {reason}"),
             Self::Solver(reason) => write!(f, "the eigensolver failed: {reason}"),
             Self::NoModes { max_freq_hz } => {
-                write!(f, "no mode below {max_freq_hz} Hz: the object is too small or too stiff")
+                write!(
+                    f,
+                    "no mode below {max_freq_hz} Hz: the object is too small or too stiff"
+                )
             }
         }
     }
@@ -400,8 +411,8 @@ impl MeshModes {
         let mut weights: Vec<(usize, f64)> = Vec::with_capacity(8);
         for c in 0..8 {
             let offset = [c & 1, c >> 1 & 1, c >> 2 & 1];
-            let index = (cell[0] + offset[0])
-                + cx * ((cell[1] + offset[1]) + cy * (cell[2] + offset[2]));
+            let index =
+                (cell[0] + offset[0]) + cx * ((cell[1] + offset[1]) + cy * (cell[2] + offset[2]));
             let w: f64 = (0..3)
                 .map(|a| if offset[a] == 1 { t[a] } else { 1.0 - t[a] })
                 .product();
@@ -414,9 +425,7 @@ impl MeshModes {
             .map(|shape| {
                 weights
                     .iter()
-                    .map(|&(dof, w)| {
-                        w * (0..3).map(|a| shape[dof + a] * direction[a]).sum::<f64>()
-                    })
+                    .map(|&(dof, w)| w * (0..3).map(|a| shape[dof + a] * direction[a]).sum::<f64>())
                     .sum()
             })
             .collect()

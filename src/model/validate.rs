@@ -24,8 +24,8 @@ pub const MAX_POSITIONS: usize = 64;
 /// generous set and let truncation and pruning choose.
 pub const MAX_MODES: usize = 65_536;
 
-/// Most coordinates of a strike position: along a line (1) or on a surface (2).
-pub const MAX_COORDS: usize = 2;
+/// Most coordinates of a strike position: along a line (1), on a surface (2) or in space (3).
+pub const MAX_COORDS: usize = 3;
 
 /// How many problems a [`BankError`](super::io::BankError) keeps: more than anyone reads, few
 /// enough that a bank with every gain wrong cannot exhaust memory.
@@ -450,7 +450,7 @@ impl<'a> UniqueNames<'a> {
 /// Positions must all have 1 or all have 2 coordinates: remembers the first valid dimension.
 #[derive(Debug, Default)]
 struct SameDimension {
-    /// Dimension of the first position with 1 or 2 coordinates, and that position's index.
+    /// Dimension of the first position with 1 to 3 coordinates, and that position's index.
     first: Option<(usize, usize)>,
 }
 
@@ -458,7 +458,8 @@ impl SameDimension {
     fn check(&mut self, i: usize, found: usize) -> Result<(), String> {
         if !(1..=MAX_COORDS).contains(&found) {
             return Err(format!(
-                "found {}, expected 1 (a point along a line) or 2 (a point on a surface)",
+                "found {}, expected 1 (a point along a line), 2 (a point on a surface) or 3 (a \
+                 point in space)",
                 coordinates(found)
             ));
         }

@@ -91,10 +91,10 @@ pub fn assemble(
                 }
             }
         }
-        for a in 0..BRICK_DOFS {
-            let Some(row) = local[a] else { continue };
-            for b in 0..BRICK_DOFS {
-                let Some(col) = local[b] else { continue };
+        for (a, row) in local.iter().enumerate() {
+            let Some(row) = *row else { continue };
+            for (b, col) in local.iter().enumerate() {
+                let Some(col) = *col else { continue };
                 if row < col {
                     continue;
                 }

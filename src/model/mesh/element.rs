@@ -144,12 +144,8 @@ fn condense(full: &[[f64; FULL_DOFS]]) -> [[f64; BRICK_DOFS]; BRICK_DOFS] {
     // Kbb^-1 Kbc by Gauss-Jordan elimination on the 9 x (9 + 24) block (Kbb is positive definite).
     let mut block = vec![[0.0; BUBBLE_DOFS + BRICK_DOFS]; BUBBLE_DOFS];
     for (i, row) in block.iter_mut().enumerate() {
-        for j in 0..BUBBLE_DOFS {
-            row[j] = full[BRICK_DOFS + i][BRICK_DOFS + j];
-        }
-        for j in 0..BRICK_DOFS {
-            row[BUBBLE_DOFS + j] = full[BRICK_DOFS + i][j];
-        }
+        row[..BUBBLE_DOFS].copy_from_slice(&full[BRICK_DOFS + i][BRICK_DOFS..]);
+        row[BUBBLE_DOFS..].copy_from_slice(&full[BRICK_DOFS + i][..BRICK_DOFS]);
     }
     for pivot in 0..BUBBLE_DOFS {
         let p = block[pivot][pivot];
@@ -199,7 +195,11 @@ mod tests {
         let mut u = [0.0; BRICK_DOFS];
         for c in 0..8 {
             let n = corner(c);
-            let p = [0.5 * n[0] * size[0], 0.5 * n[1] * size[1], 0.5 * n[2] * size[2]];
+            let p = [
+                0.5 * n[0] * size[0],
+                0.5 * n[1] * size[1],
+                0.5 * n[2] * size[2],
+            ];
             u[3 * c..3 * c + 3].copy_from_slice(&field(p));
         }
         u
@@ -210,13 +210,14 @@ mod tests {
         let size = [0.002, 0.003, 0.0015];
         let brick = steel_brick(size);
         let scale = brick.stiffness[0][0] * 1e-3;
-        let motions: [Box<dyn Fn([f64; 3]) -> [f64; 3]>; 6] = [
-            Box::new(|_| [1e-3, 0.0, 0.0]),
-            Box::new(|_| [0.0, 1e-3, 0.0]),
-            Box::new(|_| [0.0, 0.0, 1e-3]),
-            Box::new(|p| [-p[1], p[0], 0.0]),
-            Box::new(|p| [0.0, -p[2], p[1]]),
-            Box::new(|p| [p[2], 0.0, -p[0]]),
+        type Motion = fn([f64; 3]) -> [f64; 3];
+        let motions: [Motion; 6] = [
+            |_| [1e-3, 0.0, 0.0],
+            |_| [0.0, 1e-3, 0.0],
+            |_| [0.0, 0.0, 1e-3],
+            |p| [-p[1], p[0], 0.0],
+            |p| [0.0, -p[2], p[1]],
+            |p| [p[2], 0.0, -p[0]],
         ];
         for (m, motion) in motions.iter().enumerate() {
             let f = apply(&brick.stiffness, &at_corners(size, motion));
@@ -233,12 +234,18 @@ mod tests {
         for a in 0..BRICK_DOFS {
             for b in 0..BRICK_DOFS {
                 let (x, y) = (brick.stiffness[a][b], brick.stiffness[b][a]);
-                assert!((x - y).abs() <= 1e-9 * x.abs().max(1.0), "K[{a}][{b}] {x} vs {y}");
+                assert!(
+                    (x - y).abs() <= 1e-9 * x.abs().max(1.0),
+                    "K[{a}][{b}] {x} vs {y}"
+                );
             }
         }
         let total: f64 = brick.mass.iter().flatten().sum();
         let expected = 7850.0 * size[0] * size[1] * size[2];
-        assert!((total / expected - 1.0).abs() < 1e-12, "{total} vs {expected}");
+        assert!(
+            (total / expected - 1.0).abs() < 1e-12,
+            "{total} vs {expected}"
+        );
     }
 
     /// Pure bending of a beam along x, bent in the x-z plane: `u = -z x / R`, `w = x^2 / (2 R)`

@@ -40,7 +40,10 @@ pub fn cuboid(size_m: [f64; 3]) -> Surface {
 pub fn revolve(profile: &[[f64; 2]], segments: usize) -> Surface {
     let n = profile.len();
     assert!(n >= 3 && segments >= 3, "a profile of 3 points, 3 segments");
-    assert!(profile[0][0] == 0.0 && profile[n - 1][0] == 0.0, "ends on the axis");
+    assert!(
+        profile[0][0] == 0.0 && profile[n - 1][0] == 0.0,
+        "ends on the axis"
+    );
     let mut vertices = Vec::new();
     // Index of each profile point's ring (one vertex for points on the axis).
     let mut ring = Vec::with_capacity(n);
@@ -173,7 +176,16 @@ mod tests {
         assert!((disc.signed_volume_m3() / expected - 1.0).abs() < 1e-9);
 
         let u = extrude(
-            &[[0.0, 0.0], [0.03, 0.0], [0.03, 0.05], [0.02, 0.05], [0.02, 0.01], [0.01, 0.01], [0.01, 0.05], [0.0, 0.05]],
+            &[
+                [0.0, 0.0],
+                [0.03, 0.0],
+                [0.03, 0.05],
+                [0.02, 0.05],
+                [0.02, 0.01],
+                [0.01, 0.01],
+                [0.01, 0.05],
+                [0.0, 0.05],
+            ],
             0.005,
         );
         u.check().unwrap();

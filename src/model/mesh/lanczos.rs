@@ -61,7 +61,9 @@ pub fn lowest_eigenpairs(
     let n = system.dofs;
     let count = count.min(n);
     if count == 0 {
-        return Err(MeshError::Solver("no degree of freedom is free".to_string()));
+        return Err(MeshError::Solver(
+            "no degree of freedom is free".to_string(),
+        ));
     }
     progress(SolveStage::Factorising);
     let shifted: Vec<f64> = system
@@ -146,7 +148,12 @@ pub fn lowest_eigenpairs(
 
 /// `sqrt(w^T M w)` from `w` and `M w`.
 fn m_norm(w: &[f64], mw: &[f64]) -> f64 {
-    w.iter().zip(mw).map(|(a, b)| a * b).sum::<f64>().max(0.0).sqrt()
+    w.iter()
+        .zip(mw)
+        .map(|(a, b)| a * b)
+        .sum::<f64>()
+        .max(0.0)
+        .sqrt()
 }
 
 /// A deterministic pseudo-random vector (xorshift), so solves repeat exactly.

@@ -26,7 +26,10 @@ pub fn parse_surface(name: &str, bytes: &[u8]) -> Result<Surface, MeshError> {
 /// `bytes` as UTF-8 text.
 fn text(bytes: &[u8]) -> Result<&str, MeshError> {
     std::str::from_utf8(bytes).map_err(|e| MeshError::Syntax {
-        line: 1 + bytes[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count(),
+        line: 1 + bytes[..e.valid_up_to()]
+            .iter()
+            .filter(|&&b| b == b'\n')
+            .count(),
         message: "not text (and not a binary STL)".to_string(),
     })
 }
@@ -79,7 +82,11 @@ fn parse_obj(text: &str) -> Result<Surface, MeshError> {
                         line,
                         message: format!("vertex reference \"{word}\" is not an index"),
                     })?;
-                    let resolved = if i < 0 { vertices.len() as i64 + i } else { i - 1 };
+                    let resolved = if i < 0 {
+                        vertices.len() as i64 + i
+                    } else {
+                        i - 1
+                    };
                     if resolved < 0 || resolved >= vertices.len() as i64 {
                         return Err(MeshError::Syntax {
                             line,

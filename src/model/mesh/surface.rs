@@ -127,7 +127,12 @@ impl Surface {
         sorted.sort_unstable_by_key(|(key, _)| *key);
         for ((a, b), uses) in sorted {
             match uses.as_slice() {
-                [(face, _)] => return Err(MeshError::Open { face: *face, edge: [a, b] }),
+                [(face, _)] => {
+                    return Err(MeshError::Open {
+                        face: *face,
+                        edge: [a, b],
+                    })
+                }
                 [(first, da), (second, db)] if da == db => {
                     return Err(MeshError::Inconsistent {
                         faces: [*first, *second],
@@ -169,7 +174,8 @@ impl Surface {
 
 /// The point of triangle `abc` nearest `p` (Ericson, Real-Time Collision Detection, 5.1.5).
 fn closest_on_triangle(p: [f64; 3], a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> [f64; 3] {
-    let along = |o: [f64; 3], d: [f64; 3], t: f64| [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
+    let along =
+        |o: [f64; 3], d: [f64; 3], t: f64| [o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]];
     let (ab, ac, ap) = (sub(b, a), sub(c, a), sub(p, a));
     let (d1, d2) = (dot(ab, ap), dot(ac, ap));
     if d1 <= 0.0 && d2 <= 0.0 {

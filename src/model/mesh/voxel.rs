@@ -179,9 +179,8 @@ fn crossings_by_column(
     size_m: [f64; 3],
     dims: [usize; 3],
 ) -> Vec<Vec<f64>> {
-    let ray = |axis: usize, n: usize| {
-        origin_m[axis] + (n as f64 + 0.5 + RAY_OFFSET[axis]) * size_m[axis]
-    };
+    let ray =
+        |axis: usize, n: usize| origin_m[axis] + (n as f64 + 0.5 + RAY_OFFSET[axis]) * size_m[axis];
     let mut columns: Vec<Vec<f64>> = vec![Vec::new(); dims[0] * dims[1]];
     for t in 0..surface.triangles.len() {
         let [a, b, c] = surface.corners(t);

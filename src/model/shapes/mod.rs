@@ -43,6 +43,8 @@ pub use rect_membrane::RectangularMembrane;
 pub use shape::Shape;
 pub use string::StretchedString;
 
+pub(crate) use shape_describe::solid_contact_ms;
+
 use crate::model::materials::{Material, AIR_DAMPING_PER_S};
 use crate::model::{Bank, BankDefaults, Mode, Position};
 use serde_json::{json, Map, Value};

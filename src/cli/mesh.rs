@@ -1,0 +1,336 @@
+//! `modal-resonator mesh`: a bank from a 3-D model (the library's `model::mesh`).
+
+use std::path::PathBuf;
+
+use clap::Args;
+use sha2::{Digest, Sha256};
+
+use modal_resonator::model::materials::Material;
+use modal_resonator::model::mesh::{
+    bank_from_modes, parse_surface, solve_modes, spread_strike_points, strike_points, Clamp,
+    MeshModes, MeshSettings, MeshSource, MeshStage, SolveStage, StrikeRequest, Surface,
+    DEFAULT_ELEMENTS,
+};
+use modal_resonator::model::shapes::{ModeLimits, MAX_AUDIBLE_HZ};
+use modal_resonator::model::summary::note_name;
+
+use super::progress::Progress;
+use super::shape::{parse_material, parse_positive};
+use super::{check_output_dir, save_bank_output, say};
+
+/// A mesh file larger than this is refused before it is read.
+const MAX_MESH_FILE_BYTES: u64 = 512 << 20;
+
+/// Strike points spread over the surface when none are given.
+const DEFAULT_POINTS: usize = 6;
+
+/// Arguments of `mesh`.
+#[derive(Debug, Args)]
+pub(super) struct MeshArgs {
+    /// Closed surface of the object: Wavefront OBJ or STL (ASCII or binary).
+    #[arg(value_name = "MESH")]
+    input: PathBuf,
+    /// Bank file (JSON) to write; - writes it to standard output.
+    #[arg(short, long, value_name = "FILE")]
+    output: PathBuf,
+    /// Metres per unit of the file's coordinates (0.001 for a file in millimetres).
+    #[arg(long, default_value_t = 1.0, value_parser = parse_positive, value_name = "M")]
+    scale: f64,
+    /// Material (those of `shape`); its constants can be overridden one by one below.
+    #[arg(long, value_parser = parse_material, default_value = "steel")]
+    material: &'static Material,
+    /// Density in kg/m^3, instead of the material's.
+    #[arg(long, value_parser = parse_positive, value_name = "KG_M3")]
+    density: Option<f64>,
+    /// Young's modulus in Pa, instead of the material's.
+    #[arg(long, value_parser = parse_positive, value_name = "PA")]
+    youngs_modulus: Option<f64>,
+    /// Poisson's ratio (0 to 0.49), instead of the material's.
+    #[arg(long, value_parser = parse_poisson, value_name = "NU")]
+    poisson: Option<f64>,
+    /// Loss factor (1/Q of internal friction), instead of the material's.
+    #[arg(long, value_parser = parse_positive, value_name = "ETA")]
+    loss_factor: Option<f64>,
+    /// Held parts, repeatable: a plane as "z<0.002" or "x>0.25" (file units: everything on
+    /// that side is clamped), or mesh vertices as "vertices=0,17,42" (0-based; the solid
+    /// within a voxel of each is clamped). Free when absent.
+    #[arg(long, value_name = "WHERE")]
+    fix: Vec<String>,
+    /// Strike points: "NAME=X,Y,Z; ..." in file units (moved onto the nearest surface point),
+    /// or a count of points to spread over the surface.
+    #[arg(long, value_name = "LIST")]
+    positions: Option<String>,
+    /// Voxels (elements) to aim for: more is finer and slower.
+    #[arg(long, default_value_t = DEFAULT_ELEMENTS, value_name = "N")]
+    elements: usize,
+    /// Number of modes to find, the lowest.
+    #[arg(long, default_value_t = 100, value_name = "N")]
+    modes: usize,
+    /// Modes at or above this frequency in Hz are left out.
+    #[arg(long, default_value_t = MAX_AUDIBLE_HZ, value_parser = parse_positive, value_name = "HZ")]
+    max_hz: f64,
+    /// Bank name (default: the mesh file's name).
+    #[arg(long)]
+    name: Option<String>,
+    /// Author written into the bank.
+    #[arg(long, default_value = "")]
+    author: String,
+    /// SPDX licence of the bank.
+    #[arg(long, default_value = "CC0-1.0")]
+    license: String,
+}
+
+/// Builds the bank, saves it atomically and prints what it is. Nothing is written on failure.
+pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
+    check_output_dir(&args.output)?;
+    let place = args.input.display().to_string();
+    let (surface, source) = read_mesh(args)?;
+    let settings = MeshSettings {
+        material: material(args),
+        elements: args.elements,
+        clamps: clamps(&args.fix, &surface, args.scale)?,
+        modes: args.modes,
+    };
+    let modes = solve_with_progress(&surface, &settings).map_err(|e| format!("{place}: {e}"))?;
+    let points = match args.positions.as_deref() {
+        None => spread_strike_points(&surface, DEFAULT_POINTS),
+        Some(text) => match text.trim().parse::<usize>() {
+            Ok(count) if (1..=64).contains(&count) => spread_strike_points(&surface, count),
+            Ok(count) => return Err(format!("--positions {count}: expected 1 to 64 points")),
+            Err(_) => strike_points(&surface, &parse_points(text, args.scale)?),
+        },
+    };
+    let limits = ModeLimits {
+        max_freq_hz: args.max_hz,
+        max_modes: args.modes,
+    };
+    let name = args.name.clone().unwrap_or_else(|| {
+        args.input
+            .file_stem()
+            .map(|s| s.to_string_lossy().replace(['_', '-'], " "))
+            .unwrap_or_else(|| "Meshed object".to_string())
+    });
+    let mut bank = bank_from_modes(&name, &modes, &settings, &points, &limits, &source)
+        .map_err(|e| format!("{place}: {e}"))?;
+    if !args.author.is_empty() {
+        bank.author = args.author.clone();
+    }
+    bank.license = args.license.clone();
+    save_bank_output(&bank, &args.output)?;
+    report(args, &modes, &bank);
+    Ok(())
+}
+
+/// The surface in metres, and what the bank records of its file.
+fn read_mesh(args: &MeshArgs) -> Result<(Surface, MeshSource), String> {
+    let place = args.input.display().to_string();
+    let size = std::fs::metadata(&args.input)
+        .map_err(|e| format!("{place}: cannot read: {e}"))?
+        .len();
+    if size > MAX_MESH_FILE_BYTES {
+        return Err(format!(
+            "{place}: {size} bytes, more than the {MAX_MESH_FILE_BYTES} a mesh may have"
+        ));
+    }
+    let bytes = std::fs::read(&args.input).map_err(|e| format!("{place}: cannot read: {e}"))?;
+    let file_name = args
+        .input
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut surface = parse_surface(&file_name, &bytes).map_err(|e| format!("{place}: {e}"))?;
+    surface.scale(args.scale);
+    let sha256 = Sha256::digest(&bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    let source = MeshSource {
+        file_name,
+        sha256,
+        scale: args.scale,
+    };
+    Ok((surface, source))
+}
+
+/// The material with the overrides given.
+fn material(args: &MeshArgs) -> Material {
+    let mut material = *args.material;
+    if let Some(v) = args.density {
+        material.density_kg_m3 = v;
+    }
+    if let Some(v) = args.youngs_modulus {
+        material.youngs_modulus_pa = v;
+    }
+    if let Some(v) = args.poisson {
+        material.poisson_ratio = v;
+    }
+    if let Some(v) = args.loss_factor {
+        material.loss_factor = v;
+    }
+    material
+}
+
+/// Solves with a progress bar for each stage.
+fn solve_with_progress(
+    surface: &Surface,
+    settings: &MeshSettings,
+) -> Result<MeshModes, modal_resonator::model::mesh::MeshError> {
+    let mut bar: Option<(&'static str, Progress)> = None;
+    let mut stage_bar = |label: &'static str, done: f64| {
+        if bar.as_ref().is_none_or(|(l, _)| *l != label) {
+            if let Some((_, old)) = bar.take() {
+                old.finish();
+            }
+            bar = Some((label, Progress::new(label)));
+        }
+        if let Some((_, progress)) = bar.as_mut() {
+            progress.set(done);
+        }
+    };
+    let modes = solve_modes(surface, settings, &mut |stage| match stage {
+        MeshStage::Voxelising => stage_bar("voxelising", 0.0),
+        MeshStage::Assembling { .. } => stage_bar("assembling", 0.0),
+        MeshStage::Solving(SolveStage::Factorising) => stage_bar("factorising", 0.0),
+        MeshStage::Solving(SolveStage::Iterating { steps, expected }) => {
+            stage_bar("iterating", steps as f64 / expected.max(1) as f64)
+        }
+    });
+    if let Some((_, progress)) = bar {
+        progress.finish();
+    }
+    modes
+}
+
+/// Parses `--poisson`.
+fn parse_poisson(text: &str) -> Result<f64, String> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| (0.0..0.5).contains(v))
+        .ok_or_else(|| format!("expected a number from 0 up to 0.5, found \"{text}\""))
+}
+
+/// Parses `--positions` as named points: `NAME=X,Y,Z` separated by semicolons, in file units.
+fn parse_points(text: &str, scale: f64) -> Result<Vec<StrikeRequest>, String> {
+    let points = text
+        .split(';')
+        .map(str::trim)
+        .filter(|item| !item.is_empty())
+        .map(|item| {
+            let expected = || format!("--positions \"{item}\": expected NAME=X,Y,Z with numbers");
+            let (name, coords) = item.split_once('=').ok_or_else(expected)?;
+            let values = coords
+                .split(',')
+                .map(|c| c.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
+                .collect::<Option<Vec<f64>>>()
+                .filter(|c| c.len() == 3)
+                .ok_or_else(expected)?;
+            if name.trim().is_empty() {
+                return Err(expected());
+            }
+            Ok(StrikeRequest {
+                name: name.trim().to_string(),
+                point_m: [values[0] * scale, values[1] * scale, values[2] * scale],
+            })
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    if points.is_empty() || points.len() > 64 {
+        return Err(format!(
+            "--positions: expected 1 to 64 points, found {}",
+            points.len()
+        ));
+    }
+    Ok(points)
+}
+
+/// Parses the `--fix` options into clamps, in metres.
+fn clamps(specs: &[String], surface: &Surface, scale: f64) -> Result<Vec<Clamp>, String> {
+    let mut clamps = Vec::new();
+    for spec in specs {
+        let text = spec.trim();
+        let bad = || {
+            format!(
+                "--fix \"{spec}\": expected a plane such as \"z<0.002\" or \"x>0.25\", or \
+                 \"vertices=0,17,42\""
+            )
+        };
+        if let Some(list) = text.strip_prefix("vertices=") {
+            for item in list.split(',') {
+                let index: usize = item.trim().parse().map_err(|_| bad())?;
+                let point_m = *surface.vertices.get(index).ok_or_else(|| {
+                    format!(
+                        "--fix \"{spec}\": vertex {index} does not exist ({} vertices, from 0)",
+                        surface.vertices.len()
+                    )
+                })?;
+                clamps.push(Clamp::Near { point_m });
+            }
+            continue;
+        }
+        let axis = match text.chars().next() {
+            Some('x' | 'X') => 0,
+            Some('y' | 'Y') => 1,
+            Some('z' | 'Z') => 2,
+            _ => return Err(bad()),
+        };
+        let rest = text[1..].trim_start();
+        let (below, value) = if let Some(v) = rest.strip_prefix("<=").or(rest.strip_prefix('<')) {
+            (true, v)
+        } else if let Some(v) = rest.strip_prefix(">=").or(rest.strip_prefix('>')) {
+            (false, v)
+        } else {
+            return Err(bad());
+        };
+        let at: f64 = value
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(bad)?;
+        let at_m = at * scale;
+        clamps.push(if below {
+            Clamp::Below { axis, at_m }
+        } else {
+            Clamp::Above { axis, at_m }
+        });
+    }
+    Ok(clamps)
+}
+
+/// Prints what was made.
+fn report(args: &MeshArgs, modes: &MeshModes, bank: &modal_resonator::model::Bank) {
+    let stats = &modes.stats;
+    let say = |line: &str| say(&args.output, line);
+    say(&bank.description);
+    say(&format!(
+        "  {} elements of {:.3} mm, {} degrees of freedom, {} rigid motions left out; \
+         voxels {:.2} s, assembly {:.2} s, solve {:.2} s ({} Lanczos steps)",
+        stats.elements,
+        stats.voxel_m * 1e3,
+        stats.dofs,
+        stats.rigid_modes,
+        stats.voxelising.as_secs_f64(),
+        stats.assembling.as_secs_f64(),
+        stats.solving.as_secs_f64(),
+        stats.steps
+    ));
+    let root = bank.effective_root_hz();
+    let (lo, hi) = bank.modes.iter().fold((f64::MAX, 0.0f64), |(lo, hi), m| {
+        (lo.min(m.freq_hz), hi.max(m.freq_hz))
+    });
+    say(&format!(
+        "  root {root:.2} Hz ({}), {} modes from {lo:.2} Hz to {hi:.2} Hz, {} strike points: {}",
+        note_name(root),
+        bank.modes.len(),
+        bank.positions.len(),
+        bank.positions
+            .iter()
+            .map(|p| p.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    ));
+    say(&format!(
+        "  written to {}",
+        super::output_name(&args.output)
+    ));
+}
