@@ -101,9 +101,10 @@ pub fn extrude(outline: &[[f64; 2]], depth_m: f64) -> Surface {
     }
     for i in 0..n {
         let j = (i + 1) % n;
-        let (a, b, c, d) = (i as u32, j as u32, (j + n) as u32, (i + n) as u32);
-        triangles.push([a, b, c]);
-        triangles.push([a, c, d]);
+        // The bottom cap runs i -> j, so this side runs j -> i.
+        let (i0, j0, i1, j1) = (i as u32, j as u32, (i + n) as u32, (j + n) as u32);
+        triangles.push([j0, i0, i1]);
+        triangles.push([j0, i1, j1]);
     }
     outward(Surface {
         vertices,
