@@ -1,6 +1,7 @@
 //! The factory banks: analytic objects at musical pitches (`presets/<slug>.json`, generated from
 //! the tables in `bars.rs` and `surfaces.rs`) and banks fitted to recordings of real objects
-//! (`presets/fitted/`, built in by `fitted.rs`). All of them are built into the program.
+//! (`presets/fitted/`, built in by `fitted.rs`) and banks made from meshes the project generates
+//! (`presets/meshed/`, built in by `meshed.rs`). All of them are built into the program.
 //!
 //! The committed analytic preset files and the table in `presets/README.md` are generated here;
 //! the test `factory_presets_are_up_to_date` (tests/factory_presets.rs) fails when they drift,
@@ -9,6 +10,7 @@
 mod bars;
 mod compare;
 pub mod fitted;
+pub mod meshed;
 mod surfaces;
 mod table;
 
@@ -20,6 +22,7 @@ use crate::model::shapes::{design_bank, BankDesign, ModeLimits, Shape};
 use crate::model::{parse_bank_str, Bank};
 use crate::units::midi_key_to_hz;
 use fitted::{FittedPreset, FITTED_PRESETS};
+use meshed::{MeshedPreset, MESHED_PRESETS};
 use std::path::{Path, PathBuf};
 
 /// Name of the generated table of factory banks, next to the presets.
@@ -177,10 +180,17 @@ pub fn fitted_factory_banks() -> Vec<Bank> {
     FITTED_PRESETS.iter().map(FittedPreset::bank).collect()
 }
 
-/// Every factory bank, in display order: the analytic ones, then the fitted ones.
+/// The factory banks made from meshes, in display order (the files in `presets/meshed/`).
+pub fn meshed_factory_banks() -> Vec<Bank> {
+    MESHED_PRESETS.iter().map(MeshedPreset::bank).collect()
+}
+
+/// Every factory bank, in display order: the analytic ones, the fitted ones, then the meshed
+/// ones.
 pub fn factory_banks() -> Vec<Bank> {
     let mut banks = analytic_factory_banks();
     banks.extend(fitted_factory_banks());
+    banks.extend(meshed_factory_banks());
     banks
 }
 
@@ -229,20 +239,32 @@ pub fn factory_bank(name_or_slug: &str) -> Option<Bank> {
     {
         return Some(object.build());
     }
-    FITTED_PRESETS.iter().find_map(|preset| {
+    let fitted = FITTED_PRESETS.iter().find_map(|preset| {
         let bank = preset.bank();
         (factory_slug(&bank) == wanted || preset.stem() == wanted).then_some(bank)
+    });
+    fitted.or_else(|| {
+        MESHED_PRESETS.iter().find_map(|preset| {
+            let bank = preset.bank();
+            (factory_slug(&bank) == wanted || preset.stem() == wanted).then_some(bank)
+        })
     })
 }
 
 /// Where the factory bank's file is, relative to `presets/`: `<slug>.json` for an analytic bank,
-/// `fitted/<file>` for a fitted one.
+/// `fitted/<file>` for a fitted one, `meshed/<file>` for one made from a mesh.
 pub fn factory_file(bank: &Bank) -> String {
-    let fitted = FITTED_PRESETS
+    if let Some(preset) = FITTED_PRESETS
         .iter()
-        .find(|preset| preset.bank().name == bank.name);
-    match fitted {
-        Some(preset) => format!("fitted/{}", preset.file),
+        .find(|preset| preset.bank().name == bank.name)
+    {
+        return format!("fitted/{}", preset.file);
+    }
+    match MESHED_PRESETS
+        .iter()
+        .find(|preset| preset.bank().name == bank.name)
+    {
+        Some(preset) => format!("meshed/{}", preset.file),
         None => format!("{}.json", factory_slug(bank)),
     }
 }

@@ -21,6 +21,8 @@ fn made_from(bank: &Bank) -> String {
             "fitted to a recording: {} `{file}`",
             field("debian_package")
         )
+    } else if field("kind") == "mesh" {
+        format!("the mesh `meshes/{}`, {}", field("mesh"), field("material"))
     } else {
         format!("{}, {}", field("shape"), field("material"))
     }
@@ -34,7 +36,8 @@ pub fn factory_table_markdown(banks: &[Bank]) -> String {
          modes of the object (`src/model/shapes/`), decays from the material \
          (`src/model/materials.rs`) and gains `Psi_n(p) / omega_n` at each strike position \
          (seed 000 eq. 3.11); fitted banks (`source.kind = \"fitted\"`) were measured from a \
-         recording by `modal-resonator fit`.\n\n\
+         recording by `modal-resonator fit`; meshed banks (`source.kind = \"mesh\"`) were made \
+         by `modal-resonator mesh` from a generated mesh (see below).\n\n\
          | Name | Slug (CLI) | File | Made from | Root | Modes | Licence |\n\
          |---|---|---|---|---|---|---|\n",
     );

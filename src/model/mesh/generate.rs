@@ -112,6 +112,76 @@ pub fn extrude(outline: &[[f64; 2]], depth_m: f64) -> Surface {
     })
 }
 
+/// Points `(r, z)` in millimetres as metres.
+fn mm(points: &[[f64; 2]]) -> Vec<[f64; 2]> {
+    points.iter().map(|p| [p[0] * 1e-3, p[1] * 1e-3]).collect()
+}
+
+/// A cup without a handle: 80 mm across and 90 mm tall, walls 4 mm thick on a 6 mm base
+/// (a porcelain mug's proportions), open at the top, standing on z = 0.
+pub fn cup() -> Surface {
+    revolve(
+        &mm(&[
+            [0.0, 0.0],
+            [38.0, 0.0],
+            [40.0, 2.0],
+            [40.0, 90.0],
+            [36.0, 90.0],
+            [36.0, 6.0],
+            [0.0, 6.0],
+        ]),
+        96,
+    )
+}
+
+/// A tuning fork 6 mm thick (along y): two prongs 6 mm wide and 80 mm long, 8 mm apart, on a
+/// 6 mm bridge and a 40 mm stem 8 mm wide, in the x-z plane with the stem along -z.
+pub fn tuning_fork() -> Surface {
+    let outline = mm(&[
+        [-4.0, -40.0],
+        [4.0, -40.0],
+        [4.0, 0.0],
+        [10.0, 0.0],
+        [10.0, 86.0],
+        [4.0, 86.0],
+        [4.0, 6.0],
+        [-4.0, 6.0],
+        [-4.0, 86.0],
+        [-10.0, 86.0],
+        [-10.0, 0.0],
+        [-4.0, 0.0],
+    ]);
+    extrude(&outline, 6e-3)
+}
+
+/// A small bell 120 mm across the mouth and 100 mm tall, its wall thickening from 5 mm at the
+/// waist to 8 mm at the sound bow (the lip), crown closed, mouth down on z = 0.
+pub fn bell() -> Surface {
+    revolve(
+        &mm(&[
+            [0.0, 100.0],
+            [24.0, 100.0],
+            [30.0, 96.0],
+            [32.0, 85.0],
+            [33.0, 70.0],
+            [36.0, 50.0],
+            [42.0, 30.0],
+            [50.0, 14.0],
+            [58.0, 4.0],
+            [60.0, 0.0],
+            [54.0, 0.0],
+            [47.0, 10.0],
+            [37.0, 27.0],
+            [31.0, 48.0],
+            [28.0, 68.0],
+            [27.0, 84.0],
+            [23.0, 92.0],
+            [0.0, 92.0],
+        ]),
+        96,
+    )
+}
+
 /// `surface` with its triangles flipped if they face inward.
 fn outward(mut surface: Surface) -> Surface {
     if surface.signed_volume_m3() < 0.0 {
@@ -190,6 +260,9 @@ mod tests {
             0.005,
         );
         u.check().unwrap();
+        for (name, s) in [("cup", cup()), ("tuning fork", tuning_fork()), ("bell", bell())] {
+            s.check().unwrap_or_else(|e| panic!("{name}: {e}"));
+        }
         let area = 0.03 * 0.05 - 0.01 * 0.04;
         assert!((u.signed_volume_m3() / (area * 0.005) - 1.0).abs() < 1e-9);
     }
