@@ -7,7 +7,7 @@ use sha2::{Digest, Sha256};
 
 use modal_resonator::model::materials::Material;
 use modal_resonator::model::mesh::{
-    bank_from_modes, parse_surface, solve_modes, spread_strike_points, strike_points, Clamp,
+    bank_from_modes, combine_with_recording, parse_surface, solve_modes, spread_strike_points, strike_points, Clamp,
     MeshModes, MeshSettings, MeshSource, MeshStage, SolveStage, StrikeRequest, Surface,
     DEFAULT_ELEMENTS,
 };
@@ -60,6 +60,12 @@ pub(super) struct MeshArgs {
     /// or a count of points to spread over the surface.
     #[arg(long, value_name = "LIST")]
     positions: Option<String>,
+    /// Combine with a recording of the object struck at one point: "REC.wav=NAME" (a strike
+    /// point of --positions) or "REC.wav=X,Y,Z" (file units; added as a point named after the
+    /// recording). The bank takes the recording's frequencies, decays and levels there, and the
+    /// mesh's level ratios at the other points.
+    #[arg(long = "match", value_name = "REC.wav=POINT")]
+    match_recording: Option<String>,
     /// Voxels (elements) to aim for: more is finer and slower.
     #[arg(long, default_value_t = DEFAULT_ELEMENTS, value_name = "N")]
     elements: usize,
@@ -92,13 +98,17 @@ pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
         modes: args.modes,
     };
     let modes = solve_with_progress(&surface, &settings).map_err(|e| format!("{place}: {e}"))?;
-    let points = match args.positions.as_deref() {
+    let mut points = match args.positions.as_deref() {
         None => spread_strike_points(&surface, DEFAULT_POINTS),
         Some(text) => match text.trim().parse::<usize>() {
             Ok(count) if (1..=64).contains(&count) => spread_strike_points(&surface, count),
             Ok(count) => return Err(format!("--positions {count}: expected 1 to 64 points")),
             Err(_) => strike_points(&surface, &parse_points(text, args.scale)?),
         },
+    };
+    let recording = match args.match_recording.as_deref() {
+        Some(spec) => Some(recording_point(spec, &surface, &mut points, args.scale)?),
+        None => None,
     };
     let limits = ModeLimits {
         max_freq_hz: args.max_hz,
@@ -112,6 +122,9 @@ pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
     });
     let mut bank = bank_from_modes(&name, &modes, &settings, &points, &limits, &source)
         .map_err(|e| format!("{place}: {e}"))?;
+    if let Some((path, at)) = recording {
+        bank = matched(bank, &path, at)?;
+    }
     if !args.author.is_empty() {
         bank.author = args.author.clone();
     }
@@ -119,6 +132,82 @@ pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
     save_bank_output(&bank, &args.output)?;
     report(args, &modes, &bank);
     Ok(())
+}
+
+/// The recording and the index of its point among `points` for `--match REC=POINT` (a point
+/// given as coordinates is added to `points`).
+fn recording_point(
+    spec: &str,
+    surface: &Surface,
+    points: &mut Vec<modal_resonator::model::mesh::StrikePoint>,
+    scale: f64,
+) -> Result<(PathBuf, usize), String> {
+    let (path, point) = spec.rsplit_once('=').ok_or_else(|| {
+        format!("--match \"{spec}\": expected REC.wav=NAME or REC.wav=X,Y,Z")
+    })?;
+    let path = PathBuf::from(path.trim());
+    if let Some(k) = points.iter().position(|p| p.name == point.trim()) {
+        return Ok((path, k));
+    }
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "recording".to_string());
+    let request = parse_points(&format!("{stem}={point}"), scale).map_err(|_| {
+        let names: Vec<&str> = points.iter().map(|p| p.name.as_str()).collect();
+        format!(
+            "--match \"{spec}\": \"{point}\" is neither a strike point ({}) nor X,Y,Z",
+            names.join(", ")
+        )
+    })?;
+    if points.len() >= 64 {
+        return Err("--match: a bank has at most 64 positions".to_string());
+    }
+    points.extend(strike_points(surface, &request));
+    Ok((path, points.len() - 1))
+}
+
+/// `bank` combined with the recording at `path`, struck at position `at`.
+fn matched(
+    bank: modal_resonator::model::Bank,
+    path: &std::path::Path,
+    at: usize,
+) -> Result<modal_resonator::model::Bank, String> {
+    use modal_resonator::model::fit::{fit_bank_with_progress, read_wav_recording, FitOptions};
+    let name = bank.positions[at].name.clone();
+    let recording = read_wav_recording(path, &name).map_err(|e| e.to_string())?;
+    let options = FitOptions {
+        name: bank.name.clone(),
+        ..FitOptions::default()
+    };
+    let mut progress = Progress::new("fitting the recording");
+    let fit = fit_bank_with_progress(&[recording], &options, |done| progress.set(done));
+    progress.finish();
+    let fitted = fit.map_err(|e| format!("{}: {e}", path.display()))?.bank;
+    let (mut combined, report) = combine_with_recording(&bank, &fitted.modes, at);
+    if let Some(source) = combined.source.as_mut() {
+        source.insert(
+            "matched_recording".into(),
+            serde_json::json!({
+                "file": path.file_name().map(|n| n.to_string_lossy().into_owned()),
+                "position": name,
+                "frequency_scale": report.frequency_scale,
+                "paired_modes": report.paired,
+                "unpaired_recorded_modes": report.unpaired_recorded,
+                "mesh_modes_kept": report.kept_from_mesh,
+            }),
+        );
+    }
+    combined.description = format!(
+        "{} Matched to a recording struck at \"{name}\": {} modes paired (mesh frequencies x \
+         {:.4}), {} recorded modes unpaired, {} mesh modes the recording could not hear.",
+        combined.description,
+        report.paired,
+        report.frequency_scale,
+        report.unpaired_recorded,
+        report.kept_from_mesh
+    );
+    Ok(combined)
 }
 
 /// The surface in metres, and what the bank records of its file.

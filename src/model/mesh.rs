@@ -18,6 +18,7 @@ pub mod assemble;
 pub mod element;
 pub mod generate;
 pub mod lanczos;
+pub mod matching;
 pub mod read;
 pub mod surface;
 pub mod to_bank;
@@ -27,6 +28,7 @@ use std::fmt;
 use std::time::{Duration, Instant};
 
 pub use lanczos::SolveStage;
+pub use matching::{combine_with_recording, MatchReport};
 pub use read::{parse_surface, write_obj};
 pub use surface::Surface;
 pub use to_bank::{

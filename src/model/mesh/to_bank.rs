@@ -152,7 +152,7 @@ pub fn bank_from_modes(
         .collect();
     let mut bank = Bank::new(name, positions);
     bank.description = format!(
-        "{} object from the mesh {}, {} modes by finite elements",
+        "{} object from the mesh {}: {} modes by finite elements.",
         material.display_name,
         source.file_name,
         bank_modes.len()
