@@ -440,7 +440,7 @@ fn help_lists_the_subcommands() {
     assert!(out.status.success(), "stderr: {}", stderr(&out));
     let help = stdout(&out);
     for sub in [
-        "play", "render", "fit", "shape", "compress", "validate", "info", "list", "schema",
+        "play", "render", "fit", "shape", "mesh", "compress", "validate", "info", "list", "schema",
     ] {
         assert!(help.contains(sub), "help lacks {sub}: {help}");
     }
@@ -1697,4 +1697,161 @@ fn a_strike_setting_along_an_axis_the_bank_lacks_is_reported() {
     let out = render("strike_x=0.5");
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
+}
+
+/// A binary STL of a box `size` (in the file's units) from the origin.
+fn write_box_stl(path: &Path, size: [f64; 3]) {
+    let surface = modal_resonator::model::mesh::generate::cuboid(size);
+    let mut bytes = vec![0u8; 80];
+    bytes.extend((surface.triangles.len() as u32).to_le_bytes());
+    for t in 0..surface.triangles.len() {
+        bytes.extend([0u8; 12]);
+        for corner in surface.corners(t) {
+            for x in corner {
+                bytes.extend((x as f32).to_le_bytes());
+            }
+        }
+        bytes.extend([0u8; 2]);
+    }
+    std::fs::write(path, bytes).unwrap();
+}
+
+#[test]
+fn mesh_makes_a_bank_from_an_stl_in_millimetres() {
+    let dir = dir_with_bank();
+    write_box_stl(&dir.path().join("bar.stl"), [300.0, 30.0, 10.0]);
+    let out = run(
+        dir.path(),
+        &[
+            "mesh",
+            "bar.stl",
+            "--scale",
+            "0.001",
+            "--elements",
+            "2000",
+            "--modes",
+            "12",
+            "--positions",
+            "end=0,15,10; middle=150,15,10",
+            "-o",
+            "bar-mesh.json",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    assert!(text.contains("6 rigid motions left out"), "{text}");
+    // The first bending mode within 1 % of Euler-Bernoulli's 576.50 Hz.
+    let bank = modal_resonator::model::load_bank_file(&dir.path().join("bar-mesh.json")).unwrap();
+    let root = bank.root_hz.unwrap();
+    assert!((root / 576.5 - 1.0).abs() < 0.01, "root {root}: {text}");
+    assert_eq!(bank.positions[1].name, "middle");
+    assert_eq!(bank.positions[1].coords, vec![0.15, 0.015, 0.01]);
+    let source = bank.source.as_ref().unwrap();
+    assert_eq!(source["kind"], "mesh");
+    assert_eq!(source["mesh"], "bar.stl");
+    assert_eq!(source["mesh_sha256"].as_str().unwrap().len(), 64);
+    assert_eq!(source["material"], "steel");
+
+    // Clamped at one end it is a cantilever: no rigid motion, and 1.875^2 / 4.730^2 of the free
+    // bar's first mode (90.6 Hz).
+    let out = run(
+        dir.path(),
+        &[
+            "mesh",
+            "bar.stl",
+            "--scale",
+            "0.001",
+            "--elements",
+            "2000",
+            "--modes",
+            "4",
+            "--fix",
+            "x<0",
+            "--positions",
+            "2",
+            "-o",
+            "tine.json",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains(" 0 rigid motions left out"),
+        "{}",
+        stdout(&out)
+    );
+    let tine = modal_resonator::model::load_bank_file(&dir.path().join("tine.json")).unwrap();
+    let lowest = tine.modes[0].freq_hz;
+    assert!((lowest / 90.6 - 1.0).abs() < 0.03, "cantilever {lowest} Hz");
+
+    // Matched to a recording struck at its end: the recording's 440 Hz is the bank's lowest mode.
+    write_strike_wav(&dir.path().join("strike.wav"), 1);
+    let out = run(
+        dir.path(),
+        &[
+            "mesh",
+            "bar.stl",
+            "--scale",
+            "0.001",
+            "--elements",
+            "2000",
+            "--modes",
+            "12",
+            "--positions",
+            "end=0,15,10; middle=150,15,10",
+            "--match",
+            "strike.wav=end",
+            "-o",
+            "matched.json",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let matched = modal_resonator::model::load_bank_file(&dir.path().join("matched.json")).unwrap();
+    let at_440 = matched
+        .modes
+        .iter()
+        .find(|m| (m.freq_hz - 440.0).abs() < 0.5)
+        .unwrap_or_else(|| panic!("no 440 Hz mode: {:?}", matched.modes));
+    // Paired with the mesh's first bending mode: quieter at the middle than at the end.
+    assert!(at_440.gains[1].abs() < at_440.gains[0].abs(), "{at_440:?}");
+    let record = &matched.source.as_ref().unwrap()["matched_recording"];
+    assert_eq!(record["position"], "end");
+    assert!(record["paired_modes"].as_u64().unwrap() >= 1, "{record}");
+}
+
+#[test]
+fn mesh_refuses_bad_meshes_and_options_cleanly() {
+    let dir = dir_with_bank();
+    let open = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\n";
+    std::fs::write(dir.path().join("open.obj"), open).unwrap();
+    let out = run(dir.path(), &["mesh", "open.obj", "-o", "out.json"]);
+    assert_failed_cleanly(
+        &out,
+        &["open.obj", "not closed", "edge"],
+        dir.path(),
+        &["open.obj"],
+    );
+
+    write_box_stl(&dir.path().join("box.stl"), [0.1, 0.1, 0.1]);
+    let extra = ["box.stl", "open.obj"];
+    for (args, expected) in [
+        (vec!["--fix", "w<3"], "--fix \"w<3\""),
+        (vec!["--fix", "vertices=99"], "vertex 99 does not exist"),
+        (vec!["--positions", "rim=1,2"], "expected NAME=X,Y,Z"),
+        (vec!["--positions", "0"], "expected 1 to 64 points"),
+        (
+            vec!["--match", "missing.wav=nowhere"],
+            "neither a strike point",
+        ),
+        (
+            vec!["--positions", "2", "--match", "missing.wav=p1"],
+            "missing.wav",
+        ),
+        (vec!["--elements", "2"], "elements: expected at least 8"),
+    ] {
+        let mut all = vec!["mesh", "box.stl"];
+        all.extend(args.iter().copied());
+        all.extend(["-o", "out.json"]);
+        let out = run(dir.path(), &all);
+        assert_failed_cleanly(&out, &[expected], dir.path(), &extra);
+    }
 }

@@ -556,8 +556,15 @@ fn a_mesh_matched_to_a_recording_at_one_point_has_the_object_s_gains_at_the_othe
         width_m: w,
         thickness_m: t,
     });
-    let analytic = build_bank("Bar", "", &shape, &STEEL, &positions, &ModeLimits::default())
-        .expect("the analytic bar");
+    let analytic = build_bank(
+        "Bar",
+        "",
+        &shape,
+        &STEEL,
+        &positions,
+        &ModeLimits::default(),
+    )
+    .expect("the analytic bar");
     // The analytic bank lists its usual strike point first: find each point by name.
     let column = |name: &str| {
         analytic
@@ -569,7 +576,9 @@ fn a_mesh_matched_to_a_recording_at_one_point_has_the_object_s_gains_at_the_othe
     let rate = 48_000;
     let samples = resynthesize(&analytic, column("end"), rate, 2 * rate as usize);
     let recording = Recording::new("end", samples, rate);
-    let fitted = fit_bank(&[recording], &FitOptions::default()).expect("the fit").bank;
+    let fitted = fit_bank(&[recording], &FitOptions::default())
+        .expect("the fit")
+        .bank;
 
     // The meshed bar at the same points, matched to the recording at its end.
     let bar = generate::cuboid(BAR_M);
@@ -593,9 +602,15 @@ fn a_mesh_matched_to_a_recording_at_one_point_has_the_object_s_gains_at_the_othe
         scale: 1.0,
     };
     let points = strike_points(&bar, &requests);
-    let mesh_bank =
-        bank_from_modes("Bar", &modes, &settings, &points, &ModeLimits::default(), &source)
-            .expect("the mesh bank");
+    let mesh_bank = bank_from_modes(
+        "Bar",
+        &modes,
+        &settings,
+        &points,
+        &ModeLimits::default(),
+        &source,
+    )
+    .expect("the mesh bank");
     let (matched, report) = combine_with_recording(&mesh_bank, &fitted.modes, 0);
     println!("{report:?}");
     assert!(report.paired >= 4, "{report:?}");
@@ -622,8 +637,17 @@ fn a_mesh_matched_to_a_recording_at_one_point_has_the_object_s_gains_at_the_othe
                 "{:.1} Hz at {}: {got:+.3} of the end, analytic {expected:+.3} ({off_db:+.2} dB)",
                 mode.freq_hz, positions[p].name
             );
-            assert!(got.signum() == expected.signum(), "sign at {}", positions[p].name);
-            assert!(off_db.abs() < 2.0, "{:.1} Hz at {}: {off_db:+.2} dB", mode.freq_hz, positions[p].name);
+            assert!(
+                got.signum() == expected.signum(),
+                "sign at {}",
+                positions[p].name
+            );
+            assert!(
+                off_db.abs() < 2.0,
+                "{:.1} Hz at {}: {off_db:+.2} dB",
+                mode.freq_hz,
+                positions[p].name
+            );
             compared += 1;
         }
     }
@@ -634,5 +658,8 @@ fn a_mesh_matched_to_a_recording_at_one_point_has_the_object_s_gains_at_the_othe
         .iter()
         .filter(|m| m.gains.iter().all(|&g| g == m.gains[0]))
         .count();
-    assert!(unpaired >= report.unpaired_recorded, "{unpaired} modes with one gain everywhere");
+    assert!(
+        unpaired >= report.unpaired_recorded,
+        "{unpaired} modes with one gain everywhere"
+    );
 }

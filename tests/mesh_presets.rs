@@ -36,7 +36,11 @@ fn difference(a: &Bank, b: &Bank) -> Option<String> {
         if !close(m.freq_hz, n.freq_hz) || !close(m.decay_per_s, n.decay_per_s) {
             return Some(format!("modes[{k}]: {m:?} vs {n:?}"));
         }
-        if m.gains.iter().zip(&n.gains).any(|(g, h)| (g - h).abs() > 1e-6) {
+        if m.gains
+            .iter()
+            .zip(&n.gains)
+            .any(|(g, h)| (g - h).abs() > 1e-6)
+        {
             return Some(format!("modes[{k}].gains: {:?} vs {:?}", m.gains, n.gains));
         }
     }
@@ -81,7 +85,11 @@ fn meshed_presets_are_made_by_their_commands_from_generated_meshes() {
         assert_eq!(read.triangles, surface.triangles, "{}", preset.mesh_file);
         for (k, (a, b)) in read.vertices.iter().zip(&surface.vertices).enumerate() {
             let off = (0..3).map(|i| (a[i] - b[i]).abs()).fold(0.0, f64::max);
-            assert!(off < 1e-12, "{} vertex {k}: {a:?} vs {b:?}", preset.mesh_file);
+            assert!(
+                off < 1e-12,
+                "{} vertex {k}: {a:?} vs {b:?}",
+                preset.mesh_file
+            );
         }
 
         let made = dir.path().join(preset.file);

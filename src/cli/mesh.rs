@@ -5,11 +5,14 @@ use std::path::PathBuf;
 use clap::Args;
 use sha2::{Digest, Sha256};
 
+use modal_resonator::model::fit::{
+    fit_bank_with_progress, read_wav_recording, FitOptions, Recording,
+};
 use modal_resonator::model::materials::Material;
 use modal_resonator::model::mesh::{
-    bank_from_modes, combine_with_recording, parse_surface, solve_modes, spread_strike_points, strike_points, Clamp,
-    MeshModes, MeshSettings, MeshSource, MeshStage, SolveStage, StrikeRequest, Surface,
-    DEFAULT_ELEMENTS,
+    bank_from_modes, combine_with_recording, parse_surface, solve_modes, spread_strike_points,
+    strike_points, Clamp, MeshModes, MeshSettings, MeshSource, MeshStage, SolveStage,
+    StrikeRequest, Surface, DEFAULT_ELEMENTS,
 };
 use modal_resonator::model::shapes::{ModeLimits, MAX_AUDIBLE_HZ};
 use modal_resonator::model::summary::note_name;
@@ -97,7 +100,7 @@ pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
         clamps: clamps(&args.fix, &surface, args.scale)?,
         modes: args.modes,
     };
-    let modes = solve_with_progress(&surface, &settings).map_err(|e| format!("{place}: {e}"))?;
+    // Strike points and the recording first: a mistake in them is reported before the solve.
     let mut points = match args.positions.as_deref() {
         None => spread_strike_points(&surface, DEFAULT_POINTS),
         Some(text) => match text.trim().parse::<usize>() {
@@ -110,6 +113,7 @@ pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
         Some(spec) => Some(recording_point(spec, &surface, &mut points, args.scale)?),
         None => None,
     };
+    let modes = solve_with_progress(&surface, &settings).map_err(|e| format!("{place}: {e}"))?;
     let limits = ModeLimits {
         max_freq_hz: args.max_hz,
         max_modes: args.modes,
@@ -122,8 +126,8 @@ pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
     });
     let mut bank = bank_from_modes(&name, &modes, &settings, &points, &limits, &source)
         .map_err(|e| format!("{place}: {e}"))?;
-    if let Some((path, at)) = recording {
-        bank = matched(bank, &path, at)?;
+    if let Some((recording, at, file_name)) = recording {
+        bank = matched(bank, &recording, at, &file_name)?;
     }
     if !args.author.is_empty() {
         bank.author = args.author.clone();
@@ -134,20 +138,25 @@ pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
     Ok(())
 }
 
-/// The recording and the index of its point among `points` for `--match REC=POINT` (a point
-/// given as coordinates is added to `points`).
+/// The recording (read) and the index of its point among `points` for `--match REC=POINT` (a
+/// point given as coordinates is added to `points`).
 fn recording_point(
     spec: &str,
     surface: &Surface,
     points: &mut Vec<modal_resonator::model::mesh::StrikePoint>,
     scale: f64,
-) -> Result<(PathBuf, usize), String> {
-    let (path, point) = spec.rsplit_once('=').ok_or_else(|| {
-        format!("--match \"{spec}\": expected REC.wav=NAME or REC.wav=X,Y,Z")
-    })?;
+) -> Result<(Recording, usize, String), String> {
+    let (path, point) = spec
+        .rsplit_once('=')
+        .ok_or_else(|| format!("--match \"{spec}\": expected REC.wav=NAME or REC.wav=X,Y,Z"))?;
     let path = PathBuf::from(path.trim());
+    let read = |name: &str| read_wav_recording(&path, name).map_err(|e| e.to_string());
+    let file_name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     if let Some(k) = points.iter().position(|p| p.name == point.trim()) {
-        return Ok((path, k));
+        return Ok((read(&points[k].name)?, k, file_name));
     }
     let stem = path
         .file_stem()
@@ -163,33 +172,35 @@ fn recording_point(
     if points.len() >= 64 {
         return Err("--match: a bank has at most 64 positions".to_string());
     }
+    let recording = read(&request[0].name)?;
     points.extend(strike_points(surface, &request));
-    Ok((path, points.len() - 1))
+    Ok((recording, points.len() - 1, file_name))
 }
 
-/// `bank` combined with the recording at `path`, struck at position `at`.
+/// `bank` combined with `recording` (of the file `file_name`), struck at position `at`.
 fn matched(
     bank: modal_resonator::model::Bank,
-    path: &std::path::Path,
+    recording: &Recording,
     at: usize,
+    file_name: &str,
 ) -> Result<modal_resonator::model::Bank, String> {
-    use modal_resonator::model::fit::{fit_bank_with_progress, read_wav_recording, FitOptions};
     let name = bank.positions[at].name.clone();
-    let recording = read_wav_recording(path, &name).map_err(|e| e.to_string())?;
     let options = FitOptions {
         name: bank.name.clone(),
         ..FitOptions::default()
     };
     let mut progress = Progress::new("fitting the recording");
-    let fit = fit_bank_with_progress(&[recording], &options, |done| progress.set(done));
+    let fit = fit_bank_with_progress(std::slice::from_ref(recording), &options, |done| {
+        progress.set(done)
+    });
     progress.finish();
-    let fitted = fit.map_err(|e| format!("{}: {e}", path.display()))?.bank;
+    let fitted = fit.map_err(|e| format!("{}: {e}", recording.origin))?.bank;
     let (mut combined, report) = combine_with_recording(&bank, &fitted.modes, at);
     if let Some(source) = combined.source.as_mut() {
         source.insert(
             "matched_recording".into(),
             serde_json::json!({
-                "file": path.file_name().map(|n| n.to_string_lossy().into_owned()),
+                "file": file_name,
                 "position": name,
                 "frequency_scale": report.frequency_scale,
                 "paired_modes": report.paired,

@@ -260,7 +260,11 @@ mod tests {
             0.005,
         );
         u.check().unwrap();
-        for (name, s) in [("cup", cup()), ("tuning fork", tuning_fork()), ("bell", bell())] {
+        for (name, s) in [
+            ("cup", cup()),
+            ("tuning fork", tuning_fork()),
+            ("bell", bell()),
+        ] {
             s.check().unwrap_or_else(|e| panic!("{name}: {e}"));
         }
         let area = 0.03 * 0.05 - 0.01 * 0.04;

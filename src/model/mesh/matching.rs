@@ -131,7 +131,13 @@ pub fn combine_with_recording(mesh: &Bank, recorded: &[Mode], at: usize) -> (Ban
         // Never divide by less than the excitation floor: a point near a node of the mode.
         let reference = at_point.signum() * at_point.abs().max(floor * largest(m));
         let gains = (0..positions)
-            .map(|p| if p == at { r.gains[0] } else { r.gains[0] * m.gains[p] / reference })
+            .map(|p| {
+                if p == at {
+                    r.gains[0]
+                } else {
+                    r.gains[0] * m.gains[p] / reference
+                }
+            })
             .collect();
         levels.push(r.gains[0].abs() / at_point.abs());
         modes.push(Mode {
