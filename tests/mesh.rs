@@ -626,8 +626,8 @@ fn a_mesh_matched_to_a_recording_at_one_point_has_the_object_s_gains_at_the_othe
             .iter()
             .find(|m| (m.freq_hz / mode.freq_hz - 1.0).abs() < 0.002)
             .unwrap_or_else(|| panic!("{:.1} Hz is not in the matched bank", mode.freq_hz));
-        for p in 1..positions.len() {
-            let expected = mode.gains[column(&positions[p].name)] / mode.gains[column("end")];
+        for (p, position) in positions.iter().enumerate().skip(1) {
+            let expected = mode.gains[column(&position.name)] / mode.gains[column("end")];
             if expected.abs() < 0.1 {
                 continue; // within 20 dB of a node
             }
@@ -635,18 +635,18 @@ fn a_mesh_matched_to_a_recording_at_one_point_has_the_object_s_gains_at_the_othe
             let off_db = 20.0 * (got / expected).abs().log10();
             println!(
                 "{:.1} Hz at {}: {got:+.3} of the end, analytic {expected:+.3} ({off_db:+.2} dB)",
-                mode.freq_hz, positions[p].name
+                mode.freq_hz, position.name
             );
             assert!(
                 got.signum() == expected.signum(),
                 "sign at {}",
-                positions[p].name
+                position.name
             );
             assert!(
                 off_db.abs() < 2.0,
                 "{:.1} Hz at {}: {off_db:+.2} dB",
                 mode.freq_hz,
-                positions[p].name
+                position.name
             );
             compared += 1;
         }
