@@ -443,6 +443,12 @@ fn bad_meshes_are_refused_with_what_is_wrong_and_where() {
     ));
 
     assert_eq!(error_of("# nothing\n", "empty.obj"), MeshError::Empty);
+    // Two triangles back to back: closed, but no volume.
+    let flat = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 3 2\n";
+    assert!(matches!(
+        error_of(flat, "flat.obj"),
+        MeshError::NoVolume { .. }
+    ));
     let degenerate = format!("{cube}\nf 1 1 2\n");
     assert!(matches!(
         error_of(&degenerate, "sliver.obj"),

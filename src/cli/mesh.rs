@@ -240,6 +240,7 @@ fn read_mesh(args: &MeshArgs) -> Result<(Surface, MeshSource), String> {
         .unwrap_or_default();
     let mut surface = parse_surface(&file_name, &bytes).map_err(|e| format!("{place}: {e}"))?;
     surface.scale(args.scale);
+    surface.check().map_err(|e| format!("{place}: {e}"))?;
     let sha256 = Sha256::digest(&bytes)
         .iter()
         .map(|b| format!("{b:02x}"))
@@ -404,15 +405,16 @@ fn report(args: &MeshArgs, modes: &MeshModes, bank: &modal_resonator::model::Ban
     say(&bank.description);
     say(&format!(
         "  {} elements of {:.3} mm, {} degrees of freedom, {} rigid motions left out; \
-         voxels {:.2} s, assembly {:.2} s, solve {:.2} s ({} Lanczos steps)",
+         voxels {:.2} s, assembly {:.2} s, factorisation {:.2} s, {} Lanczos steps {:.2} s",
         stats.elements,
         stats.voxel_m * 1e3,
         stats.dofs,
         stats.rigid_modes,
         stats.voxelising.as_secs_f64(),
         stats.assembling.as_secs_f64(),
-        stats.solving.as_secs_f64(),
-        stats.steps
+        stats.factorising.as_secs_f64(),
+        stats.steps,
+        stats.iterating.as_secs_f64()
     ));
     let root = bank.effective_root_hz();
     let (lo, hi) = bank.modes.iter().fold((f64::MAX, 0.0f64), |(lo, hi), m| {

@@ -105,6 +105,11 @@ pub enum MeshError {
         /// The signed volume, negative.
         volume_m3: f64,
     },
+    /// The surface is closed but encloses (almost) nothing: it is folded flat.
+    NoVolume {
+        /// The enclosed volume.
+        volume_m3: f64,
+    },
     /// More triangles, cells or elements than can be solved.
     TooLarge {
         /// What there are too many of.
@@ -180,6 +185,11 @@ impl fmt::Display for MeshError {
                 f,
                 "the surface is inside-out (its faces point inward, signed volume {volume_m3:.3e} \
                  m^3): flip the normals"
+            ),
+            Self::NoVolume { volume_m3 } => write!(
+                f,
+                "the surface encloses no volume ({volume_m3:.3e} m^3): it is folded flat, or \
+                 its units are far too small (see --scale)"
             ),
             Self::TooLarge { what, count, limit } => write!(
                 f,
@@ -282,8 +292,10 @@ pub struct SolveStats {
     pub voxelising: Duration,
     /// Time to assemble the matrices.
     pub assembling: Duration,
-    /// Time to factorise and iterate.
-    pub solving: Duration,
+    /// Time to factorise `K - sigma M`.
+    pub factorising: Duration,
+    /// Time of the Lanczos iterations and the mode shapes.
+    pub iterating: Duration,
 }
 
 /// What the solver reports as it goes, for progress bars.
@@ -322,18 +334,7 @@ pub fn solve_modes(
     progress: &mut dyn FnMut(MeshStage),
 ) -> Result<MeshModes, MeshError> {
     surface.check()?;
-    if settings.modes == 0 {
-        return Err(MeshError::BadSetting {
-            name: "modes",
-            reason: "expected at least 1".to_string(),
-        });
-    }
-    if settings.elements < 8 {
-        return Err(MeshError::BadSetting {
-            name: "elements",
-            reason: format!("expected at least 8, found {}", settings.elements),
-        });
-    }
+    settings.check()?;
     let started = Instant::now();
     progress(MeshStage::Voxelising);
     let voxel_m = (surface.signed_volume_m3() / settings.elements as f64).cbrt();
@@ -375,21 +376,13 @@ pub fn solve_modes(
         shift,
         &mut |stage| progress(MeshStage::Solving(stage)),
     )?;
-    stats.solving = started.elapsed();
+    stats.factorising = pairs.factorising;
+    stats.iterating = started.elapsed().saturating_sub(pairs.factorising);
     stats.factor_entries = pairs.factor_entries;
     stats.steps = pairs.steps;
 
-    let rigid_limit = (std::f64::consts::TAU * RIGID_HZ).powi(2);
-    let mut freqs_hz = Vec::new();
-    let mut shapes = Vec::new();
-    for (value, vector) in pairs.values.into_iter().zip(pairs.vectors) {
-        if value < rigid_limit {
-            stats.rigid_modes += 1;
-        } else if freqs_hz.len() < settings.modes {
-            freqs_hz.push(value.sqrt() / std::f64::consts::TAU);
-            shapes.push(vector);
-        }
-    }
+    let (freqs_hz, shapes, rigid_modes) = without_rigid_motions(pairs, settings.modes);
+    stats.rigid_modes = rigid_modes;
     Ok(MeshModes {
         voxels,
         corner_dof: system.corner_dof,
@@ -397,6 +390,46 @@ pub fn solve_modes(
         shapes,
         stats,
     })
+}
+
+impl MeshSettings {
+    /// `Ok` when the settings can be solved.
+    fn check(&self) -> Result<(), MeshError> {
+        if self.modes == 0 {
+            return Err(MeshError::BadSetting {
+                name: "modes",
+                reason: "expected at least 1".to_string(),
+            });
+        }
+        if self.elements < 8 {
+            return Err(MeshError::BadSetting {
+                name: "elements",
+                reason: format!("expected at least 8, found {}", self.elements),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// The first `count` vibration modes of `pairs` (frequencies in Hz and shapes) and the number of
+/// rigid motions among them, left out.
+fn without_rigid_motions(
+    pairs: lanczos::Eigenpairs,
+    count: usize,
+) -> (Vec<f64>, Vec<Vec<f64>>, usize) {
+    let rigid_limit = (std::f64::consts::TAU * RIGID_HZ).powi(2);
+    let mut freqs_hz = Vec::new();
+    let mut shapes = Vec::new();
+    let mut rigid = 0;
+    for (value, vector) in pairs.values.into_iter().zip(pairs.vectors) {
+        if value < rigid_limit {
+            rigid += 1;
+        } else if freqs_hz.len() < count {
+            freqs_hz.push(value.sqrt() / std::f64::consts::TAU);
+            shapes.push(vector);
+        }
+    }
+    (freqs_hz, shapes, rigid)
 }
 
 impl MeshModes {

@@ -48,21 +48,45 @@ impl System {
     }
 }
 
-/// Which grid corners are clamped: `clamped(position_m)` for each corner of a solid voxel.
+/// The assembled system of the solid `voxels`, each a `brick`, with the grid corners for which
+/// `clamped(position_m)` holds left out.
 pub fn assemble(
     voxels: &Voxels,
     brick: &BrickMatrices,
     clamped: impl Fn([f64; 3]) -> bool,
 ) -> System {
+    let (corner_dof, dofs) = number_corners(voxels, clamped);
+    let entries = brick_entries(voxels, brick, &corner_dof);
+    let (col_ptr, rows, stiffness, mass) = compress(entries, dofs);
+    System {
+        dofs,
+        col_ptr,
+        rows,
+        stiffness,
+        mass,
+        corner_dof,
+    }
+}
+
+/// Index of grid corner `(i, j, k)` in a grid of `dims` voxels.
+fn corner_index(dims: [usize; 3], i: usize, j: usize, k: usize) -> usize {
+    i + (dims[0] + 1) * (j + (dims[1] + 1) * k)
+}
+
+/// The first degree of freedom of each corner of a solid voxel that is not clamped, and their
+/// count.
+fn number_corners(
+    voxels: &Voxels,
+    clamped: impl Fn([f64; 3]) -> bool,
+) -> (Vec<Option<usize>>, usize) {
     let [nx, ny, nz] = voxels.dims;
     let (cx, cy) = (nx + 1, ny + 1);
-    let corner_index = |i: usize, j: usize, k: usize| i + cx * (j + cy * k);
     let mut corner_dof = vec![None; cx * cy * (nz + 1)];
     let mut used = vec![false; corner_dof.len()];
     for (v, _) in voxels.solid.iter().enumerate().filter(|(_, &s)| s) {
         let [i, j, k] = voxels.cell(v);
         for c in 0..8 {
-            used[corner_index(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1))] = true;
+            used[corner_index(voxels.dims, i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1))] = true;
         }
     }
     let mut dofs = 0;
@@ -77,14 +101,21 @@ pub fn assemble(
             dofs += 3;
         }
     }
+    (corner_dof, dofs)
+}
 
-    // Lower-triangle entries of every brick, (column, row, k, m), merged by sorting.
-    let mut entries: Vec<(u32, u32, f64, f64)> = Vec::new();
+/// Every brick's lower-triangle entries as `(column, row, stiffness, mass)`, unmerged.
+fn brick_entries(
+    voxels: &Voxels,
+    brick: &BrickMatrices,
+    corner_dof: &[Option<usize>],
+) -> Vec<(u32, u32, f64, f64)> {
+    let mut entries = Vec::new();
     for (v, _) in voxels.solid.iter().enumerate().filter(|(_, &s)| s) {
         let [i, j, k] = voxels.cell(v);
         let mut local = [None; BRICK_DOFS];
         for c in 0..8 {
-            let corner = corner_index(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1));
+            let corner = corner_index(voxels.dims, i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1));
             if let Some(first) = corner_dof[corner] {
                 for axis in 0..3 {
                     local[3 * c + axis] = Some(first + axis);
@@ -107,12 +138,21 @@ pub fn assemble(
             }
         }
     }
-    entries.sort_unstable_by_key(|&(col, row, _, _)| (col, row));
+    entries
+}
 
+/// Compressed columns (column starts, rows, stiffness, mass) of `entries`, those at the same
+/// place summed.
+#[allow(clippy::type_complexity)]
+fn compress(
+    mut entries: Vec<(u32, u32, f64, f64)>,
+    dofs: usize,
+) -> (Vec<usize>, Vec<usize>, Vec<f64>, Vec<f64>) {
+    entries.sort_unstable_by_key(|&(col, row, _, _)| (col, row));
     let mut col_ptr = vec![0usize; dofs + 1];
     let mut rows = Vec::new();
-    let mut stiffness = Vec::new();
-    let mut mass = Vec::new();
+    let mut stiffness: Vec<f64> = Vec::new();
+    let mut mass: Vec<f64> = Vec::new();
     let mut last = None;
     for (col, row, k, m) in entries {
         if last == Some((col, row)) {
@@ -129,12 +169,5 @@ pub fn assemble(
     for col in 0..dofs {
         col_ptr[col + 1] += col_ptr[col];
     }
-    System {
-        dofs,
-        col_ptr,
-        rows,
-        stiffness,
-        mass,
-        corner_dof,
-    }
+    (col_ptr, rows, stiffness, mass)
 }

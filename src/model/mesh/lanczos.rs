@@ -8,6 +8,7 @@
 //! rigid motions (`lambda = 0`) come out first and are left out by the caller.
 
 use faer::linalg::solvers::Solve;
+use faer::sparse::linalg::solvers::Llt;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{ColRef, MatRef, Side};
 
@@ -48,6 +49,8 @@ pub struct Eigenpairs {
     pub steps: usize,
     /// Non-zero entries of the Cholesky factor.
     pub factor_entries: usize,
+    /// Time spent factorising.
+    pub factorising: std::time::Duration,
 }
 
 /// The `count` lowest eigenpairs of `system` above `shift` (in (rad/s)^2; below every eigenvalue
@@ -66,6 +69,38 @@ pub fn lowest_eigenpairs(
         ));
     }
     progress(SolveStage::Factorising);
+    let started = std::time::Instant::now();
+    let (factor, factor_entries) = factorise(system, shift)?;
+    let factorising = started.elapsed();
+
+    let max_steps = n;
+    let mut expected = (2 * count + EXTRA_STEPS).min(max_steps);
+    let mut next_check = expected.min(count + EXTRA_STEPS);
+    let mut lanczos = Lanczos::new(system, expected);
+    loop {
+        lanczos.step(system, &factor);
+        let steps = lanczos.alpha.len();
+        progress(SolveStage::Iterating { steps, expected });
+        if steps >= next_check || steps == max_steps {
+            let (alpha, beta) = (&lanczos.alpha, &lanczos.beta);
+            if let Some((thetas, ritz)) = converged(alpha, beta, count, steps == max_steps)? {
+                return Ok(Eigenpairs {
+                    values: thetas.iter().map(|theta| shift + 1.0 / theta).collect(),
+                    vectors: ritz_vectors(&lanczos.basis, n, &ritz),
+                    steps,
+                    factor_entries,
+                    factorising,
+                });
+            }
+            next_check = (steps + CHECK_EVERY).min(max_steps);
+            expected = expected.max(next_check);
+        }
+    }
+}
+
+/// The Cholesky factor of `K - shift M` and its number of entries.
+fn factorise(system: &System, shift: f64) -> Result<(Llt<usize, f64>, usize), MeshError> {
+    let n = system.dofs;
     let shifted: Vec<f64> = system
         .stiffness
         .iter()
@@ -80,7 +115,7 @@ pub fn lowest_eigenpairs(
         ))
     })?;
     // The factor's size, for the report (the symbolic analysis again: the solver keeps its own).
-    let factor_entries = faer::sparse::linalg::cholesky::factorize_symbolic_cholesky(
+    let entries = faer::sparse::linalg::cholesky::factorize_symbolic_cholesky(
         symbolic,
         Side::Lower,
         Default::default(),
@@ -88,61 +123,69 @@ pub fn lowest_eigenpairs(
     )
     .map(|s| s.len_val())
     .unwrap_or(0);
-    drop(shifted);
+    Ok((factor, entries))
+}
 
-    let max_steps = n;
-    let mut expected = (2 * count + EXTRA_STEPS).min(max_steps);
-    let mut basis: Vec<f64> = Vec::with_capacity(n * expected);
-    let mut alpha: Vec<f64> = Vec::new();
-    let mut beta: Vec<f64> = Vec::new();
-    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-    let mut w = random_vector(n, &mut seed);
-    let mut mw = vec![0.0; n];
-    let mut next_check = expected.min(count + EXTRA_STEPS);
-    loop {
-        let steps = alpha.len();
-        // Normalise w into the next basis vector (restarting if the last step broke down: w
-        // then lies in the span of the basis, an invariant subspace).
-        if steps == 0 {
-            system.mass_times(&w, &mut mw);
-        }
-        let mut b = m_norm(&w, &mw);
-        let scale = alpha.iter().fold(0.0f64, |s, a| s.max(a.abs()));
-        if steps > 0 && b <= 1e-12 * scale {
-            w = random_vector(n, &mut seed);
-            orthogonalise(&basis, n, system, &mut w, &mut mw);
-            b = m_norm(&w, &mw);
-            if steps > 0 {
-                *beta.last_mut().expect("a step") = 0.0;
-            }
-        }
-        let q: Vec<f64> = w.iter().map(|x| x / b).collect();
-        let mq: Vec<f64> = mw.iter().map(|x| x / b).collect();
-        basis.extend_from_slice(&q);
-        // w = (K - sigma M)^-1 M q
-        w.copy_from_slice(&mq);
-        factor.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut w, n, 1));
-        let a: f64 = mq.iter().zip(&w).map(|(m, w)| m * w).sum();
-        alpha.push(a);
+/// The Lanczos recurrence's state: the basis so far, the tridiagonal matrix's diagonal and
+/// off-diagonal, and the next (unnormalised) vector.
+struct Lanczos {
+    /// Length of a vector.
+    n: usize,
+    /// The `M`-orthonormal basis vectors, one after another.
+    basis: Vec<f64>,
+    /// Diagonal of the tridiagonal matrix.
+    alpha: Vec<f64>,
+    /// Its off-diagonal; the last is the norm of `w`.
+    beta: Vec<f64>,
+    /// The next vector before normalisation.
+    w: Vec<f64>,
+    /// `M w`.
+    mw: Vec<f64>,
+    /// State of the start vectors' generator.
+    seed: u64,
+}
+
+impl Lanczos {
+    /// A recurrence from a pseudo-random start, with room for `expected` steps.
+    fn new(system: &System, expected: usize) -> Self {
+        let n = system.dofs;
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let w = random_vector(n, &mut seed);
+        let mut mw = vec![0.0; n];
         system.mass_times(&w, &mut mw);
-        // beta_j is computed once w is orthogonal to the basis, at the next step's start.
-        orthogonalise(&basis, n, system, &mut w, &mut mw);
-        beta.push(m_norm(&w, &mw));
-        let steps = alpha.len();
-        progress(SolveStage::Iterating { steps, expected });
-        if steps >= next_check || steps == max_steps {
-            if let Some(pairs) = converged(&alpha, &beta, count, steps == max_steps)? {
-                let vectors = ritz_vectors(&basis, n, &pairs.1);
-                return Ok(Eigenpairs {
-                    values: pairs.0.iter().map(|theta| shift + 1.0 / theta).collect(),
-                    vectors,
-                    steps,
-                    factor_entries,
-                });
-            }
-            next_check = (steps + CHECK_EVERY).min(max_steps);
-            expected = expected.max(next_check);
+        Self {
+            n,
+            basis: Vec::with_capacity(n * expected),
+            alpha: Vec::new(),
+            beta: Vec::new(),
+            w,
+            mw,
+            seed,
         }
+    }
+
+    /// One step: `w` normalised into the next basis vector `q` (a fresh start orthogonal to
+    /// the basis if the last step broke down, `w` then lying in an invariant subspace), then
+    /// `w = (K - sigma M)^-1 M q`, its component along `q` (alpha) and its norm once
+    /// orthogonal to the whole basis (beta).
+    fn step(&mut self, system: &System, factor: &Llt<usize, f64>) {
+        let n = self.n;
+        let mut b = m_norm(&self.w, &self.mw);
+        let scale = self.alpha.iter().fold(0.0f64, |s, a| s.max(a.abs()));
+        if !self.alpha.is_empty() && b <= 1e-12 * scale {
+            self.w = random_vector(n, &mut self.seed);
+            orthogonalise(&self.basis, n, system, &mut self.w, &mut self.mw);
+            b = m_norm(&self.w, &self.mw);
+            *self.beta.last_mut().expect("a step") = 0.0;
+        }
+        let mq: Vec<f64> = self.mw.iter().map(|x| x / b).collect();
+        self.basis.extend(self.w.iter().map(|x| x / b));
+        self.w.copy_from_slice(&mq);
+        factor.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut self.w, n, 1));
+        self.alpha
+            .push(mq.iter().zip(&self.w).map(|(m, w)| m * w).sum());
+        orthogonalise(&self.basis, n, system, &mut self.w, &mut self.mw);
+        self.beta.push(m_norm(&self.w, &self.mw));
     }
 }
 

@@ -152,6 +152,10 @@ impl Surface {
         if volume < 0.0 {
             return Err(MeshError::InsideOut { volume_m3: volume });
         }
+        // A closed surface folded flat (two sheets back to back) encloses nothing.
+        if volume <= 1e-9 * scale.powi(3) {
+            return Err(MeshError::NoVolume { volume_m3: volume });
+        }
         Ok(())
     }
 
