@@ -9,8 +9,8 @@ use crate::model::materials::{Material, AIR_DAMPING_PER_S};
 use crate::model::shapes::{finish_modes, solid_contact_ms, ModeLimits, ShapeError, ShapedMode};
 use crate::model::{Bank, BankDefaults, Position};
 
-/// Strike points are stored to the micrometre.
-const COORD_STEP_M: f64 = 1e-6;
+/// Strike points are stored to the micrometre: this many steps per metre.
+const COORD_STEPS_PER_M: f64 = 1e6;
 
 /// At most this many points are candidates when spreading strike points over a surface.
 const MAX_CANDIDATES: usize = 20_000;
@@ -146,7 +146,8 @@ pub fn bank_from_modes(
             name: p.name.clone(),
             coords: p
                 .point_m
-                .map(|x| (x / COORD_STEP_M).round() * COORD_STEP_M)
+                // Divided, not multiplied by 1e-6, so 0.084 stays 0.084.
+                .map(|x| (x * COORD_STEPS_PER_M).round() / COORD_STEPS_PER_M)
                 .to_vec(),
         })
         .collect();
