@@ -1819,6 +1819,57 @@ fn mesh_makes_a_bank_from_an_stl_in_millimetres() {
 }
 
 #[test]
+fn mesh_seeks_modes_up_to_a_frequency_limit() {
+    let dir = dir_with_bank();
+    write_box_stl(&dir.path().join("bar.stl"), [0.3, 0.03, 0.01]);
+    // Asked for every mode below 1 MHz, the solve doubles its count until the cap of 500.
+    let out = run(
+        dir.path(),
+        &[
+            "mesh",
+            "bar.stl",
+            "--elements",
+            "300",
+            "--max-hz",
+            "1000000",
+            "-o",
+            "all.json",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("all 500 modes found lie below --max-hz"),
+        "{}",
+        stderr(&out)
+    );
+    let bank = modal_resonator::model::load_bank_file(&dir.path().join("all.json")).unwrap();
+    // Those the strike points excite (the rest have no gain anywhere).
+    assert!(bank.modes.len() > 100, "{} modes", bank.modes.len());
+    // With a limit the first 100 reach, one solve: every mode kept lies below it.
+    let out = run(
+        dir.path(),
+        &[
+            "mesh",
+            "bar.stl",
+            "--elements",
+            "300",
+            "--max-hz",
+            "3000",
+            "-o",
+            "low.json",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let low = modal_resonator::model::load_bank_file(&dir.path().join("low.json")).unwrap();
+    assert!(
+        low.modes.iter().all(|m| m.freq_hz < 3000.0),
+        "{:?}",
+        low.modes
+    );
+    assert!(low.modes.len() >= 2, "{:?}", low.modes);
+}
+
+#[test]
 fn mesh_refuses_bad_meshes_and_options_cleanly() {
     let dir = dir_with_bank();
     let open = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 2 3 4\n";
@@ -1847,6 +1898,14 @@ fn mesh_refuses_bad_meshes_and_options_cleanly() {
             "missing.wav",
         ),
         (vec!["--elements", "2"], "elements: expected at least 8"),
+        (
+            vec!["--modes", "100000"],
+            "expected a whole number from 1 to 500",
+        ),
+        (
+            vec!["--positions", "a=0,0,0; a=1,1,1"],
+            "\"a\" is named twice",
+        ),
     ] {
         let mut all = vec!["mesh", "box.stl"];
         all.extend(args.iter().copied());

@@ -2,7 +2,7 @@
 //! Saint-Venant torsion), a free square plate and a clamped circular plate (Leissa), the gains
 //! at a bar's nodes and ends, convergence under refinement, and every kind of bad mesh.
 
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::TAU;
 
 use modal_resonator::model::materials::{Material, STEEL};
 use modal_resonator::model::mesh::{
@@ -372,7 +372,6 @@ fn a_clamped_circular_plate_matches_the_analytic_bank() {
             modes.freqs_hz
         );
     }
-    let _ = PI;
 }
 
 fn error_of(text: &str, name: &str) -> MeshError {
@@ -443,6 +442,11 @@ fn bad_meshes_are_refused_with_what_is_wrong_and_where() {
     ));
 
     assert_eq!(error_of("# nothing\n", "empty.obj"), MeshError::Empty);
+    // A vertex no face uses (exporters leave them) is not part of the surface.
+    let stray = format!("{cube}\nv 100 100 100\n");
+    let surface = parse_surface("stray.obj", stray.as_bytes()).unwrap();
+    assert_eq!(surface.check(), Ok(()));
+    assert_eq!(surface.bounds(), ([0.0; 3], [1.0; 3]));
     // Two triangles back to back: closed, but no volume.
     let flat = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 3 2\n";
     assert!(matches!(
@@ -621,12 +625,12 @@ fn a_mesh_matched_to_a_recording_at_one_point_has_the_object_s_gains_at_the_othe
     println!("{report:?}");
     assert!(report.paired >= 4, "{report:?}");
 
-    // The analytic bar's first five modes are paired (the sixth lies 4 % from the mesh's after
-    // the common scale, the meshed bar having shear and rotary inertia): each is in the matched
-    // bank at its recorded frequency, with the analytic gain ratio to the end at every point it
-    // is not near a node of.
+    // The analytic bar's first six modes are paired (the meshed bar, with shear and rotary
+    // inertia, falls ever further below Euler-Bernoulli: 0.3 % at the first, 4 % at the sixth):
+    // each is in the matched bank at its recorded frequency, with the analytic gain ratio to the
+    // end at every point it is not near a node of.
     let mut compared = 0;
-    for mode in analytic.modes.iter().take(5) {
+    for mode in analytic.modes.iter().take(6) {
         let found = matched
             .modes
             .iter()

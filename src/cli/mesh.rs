@@ -12,7 +12,7 @@ use modal_resonator::model::materials::Material;
 use modal_resonator::model::mesh::{
     bank_from_modes, combine_with_recording, parse_surface, solve_modes, spread_strike_points,
     strike_points, Clamp, MeshModes, MeshSettings, MeshSource, MeshStage, SolveStage,
-    StrikeRequest, Surface, DEFAULT_ELEMENTS,
+    StrikeRequest, Surface, DEFAULT_ELEMENTS, MAX_MODES,
 };
 use modal_resonator::model::shapes::{ModeLimits, MAX_AUDIBLE_HZ};
 use modal_resonator::model::summary::note_name;
@@ -26,6 +26,9 @@ const MAX_MESH_FILE_BYTES: u64 = 512 << 20;
 
 /// Strike points spread over the surface when none are given.
 const DEFAULT_POINTS: usize = 6;
+
+/// Modes found when neither `--modes` nor `--max-hz` says otherwise.
+const DEFAULT_MODES: usize = 100;
 
 /// Arguments of `mesh`.
 #[derive(Debug, Args)]
@@ -72,12 +75,14 @@ pub(super) struct MeshArgs {
     /// Voxels (elements) to aim for: more is finer and slower.
     #[arg(long, default_value_t = DEFAULT_ELEMENTS, value_name = "N")]
     elements: usize,
-    /// Number of modes to find, the lowest.
-    #[arg(long, default_value_t = 100, value_name = "N")]
-    modes: usize,
-    /// Modes at or above this frequency in Hz are left out.
-    #[arg(long, default_value_t = MAX_AUDIBLE_HZ, value_parser = parse_positive, value_name = "HZ")]
-    max_hz: f64,
+    /// Number of modes to find, the lowest, 1 to 500 [default: 100, or with --max-hz as many as
+    /// lie below it, up to 500].
+    #[arg(long, value_parser = parse_modes, value_name = "N")]
+    modes: Option<usize>,
+    /// Modes at or above this frequency in Hz are left out [default: 20000]; given without
+    /// --modes, modes are sought up to it.
+    #[arg(long, value_parser = parse_positive, value_name = "HZ")]
+    max_hz: Option<f64>,
     /// Bank name (default: the mesh file's name).
     #[arg(long)]
     name: Option<String>,
@@ -94,17 +99,27 @@ pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
     check_output_dir(&args.output)?;
     let place = args.input.display().to_string();
     let (surface, source) = read_mesh(args)?;
-    let settings = MeshSettings {
+    let mut settings = MeshSettings {
         material: material(args),
         elements: args.elements,
         clamps: clamps(&args.fix, &surface, args.scale)?,
-        modes: args.modes,
+        modes: args.modes.unwrap_or(DEFAULT_MODES),
     };
     // Strike points and the recording first: a mistake in them is reported before the solve.
     let mut points = match args.positions.as_deref() {
         None => spread_strike_points(&surface, DEFAULT_POINTS),
         Some(text) => match text.trim().parse::<usize>() {
-            Ok(count) if (1..=64).contains(&count) => spread_strike_points(&surface, count),
+            Ok(count) if (1..=64).contains(&count) => {
+                let points = spread_strike_points(&surface, count);
+                if points.len() < count {
+                    eprintln!(
+                        "{place}: only {} strike points can be spread over a surface of {} faces",
+                        points.len(),
+                        surface.triangles.len()
+                    );
+                }
+                points
+            }
             Ok(count) => return Err(format!("--positions {count}: expected 1 to 64 points")),
             Err(_) => strike_points(&surface, &parse_points(text, args.scale)?),
         },
@@ -113,10 +128,10 @@ pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
         Some(spec) => Some(recording_point(spec, &surface, &mut points, args.scale)?),
         None => None,
     };
-    let modes = solve_with_progress(&surface, &settings).map_err(|e| format!("{place}: {e}"))?;
+    let modes = solve_up_to_limit(args, &surface, &mut settings)?;
     let limits = ModeLimits {
-        max_freq_hz: args.max_hz,
-        max_modes: args.modes,
+        max_freq_hz: args.max_hz.unwrap_or(MAX_AUDIBLE_HZ),
+        max_modes: settings.modes,
     };
     let name = args.name.clone().unwrap_or_else(|| {
         args.input
@@ -203,20 +218,24 @@ fn matched(
                 "file": file_name,
                 "position": name,
                 "frequency_scale": report.frequency_scale,
+                "scale_change_per_octave": report.scale_per_octave,
                 "paired_modes": report.paired,
                 "unpaired_recorded_modes": report.unpaired_recorded,
                 "mesh_modes_kept": report.kept_from_mesh,
+                "mesh_modes_dropped": report.dropped_from_mesh,
             }),
         );
     }
     combined.description = format!(
         "{} Matched to a recording struck at \"{name}\": {} modes paired (mesh frequencies x \
-         {:.4}), {} recorded modes unpaired, {} mesh modes the recording could not hear.",
+         {:.4} at the lowest), {} recorded modes unpaired, {} mesh modes the recording could not \
+         hear kept, {} it should have heard left out.",
         combined.description,
         report.paired,
         report.frequency_scale,
         report.unpaired_recorded,
-        report.kept_from_mesh
+        report.kept_from_mesh,
+        report.dropped_from_mesh
     );
     Ok(combined)
 }
@@ -251,6 +270,44 @@ fn read_mesh(args: &MeshArgs) -> Result<(Surface, MeshSource), String> {
         scale: args.scale,
     };
     Ok((surface, source))
+}
+
+/// The modes of `surface`: as many as `settings` asks, or, with `--max-hz` and no `--modes`,
+/// solved again with twice as many until one lies at or above the limit (or 500 are found).
+fn solve_up_to_limit(
+    args: &MeshArgs,
+    surface: &Surface,
+    settings: &mut MeshSettings,
+) -> Result<MeshModes, String> {
+    let place = args.input.display().to_string();
+    loop {
+        let modes = solve_with_progress(surface, settings).map_err(|e| format!("{place}: {e}"))?;
+        let Some(limit) = args.max_hz.filter(|_| args.modes.is_none()) else {
+            return Ok(modes);
+        };
+        let reached = modes.freqs_hz.last().is_none_or(|&f| f >= limit);
+        let exhausted = modes.freqs_hz.len() < settings.modes;
+        if reached || exhausted {
+            return Ok(modes);
+        }
+        if settings.modes >= MAX_MODES {
+            eprintln!(
+                "{place}: all {MAX_MODES} modes found lie below --max-hz {limit} Hz; the bank keeps \
+                 the lowest {MAX_MODES}"
+            );
+            return Ok(modes);
+        }
+        settings.modes = (2 * settings.modes).min(MAX_MODES);
+    }
+}
+
+/// Parses `--modes`.
+fn parse_modes(text: &str) -> Result<usize, String> {
+    text.trim()
+        .parse::<usize>()
+        .ok()
+        .filter(|n| (1..=MAX_MODES).contains(n))
+        .ok_or_else(|| format!("expected a whole number from 1 to {MAX_MODES}, found \"{text}\""))
 }
 
 /// The material with the overrides given.
@@ -335,6 +392,11 @@ fn parse_points(text: &str, scale: f64) -> Result<Vec<StrikeRequest>, String> {
             })
         })
         .collect::<Result<Vec<_>, String>>()?;
+    for (k, p) in points.iter().enumerate() {
+        if points[..k].iter().any(|q| q.name == p.name) {
+            return Err(format!("--positions: \"{}\" is named twice", p.name));
+        }
+    }
     if points.is_empty() || points.len() > 64 {
         return Err(format!(
             "--positions: expected 1 to 64 points, found {}",

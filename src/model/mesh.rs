@@ -41,6 +41,9 @@ use crate::model::materials::Material;
 /// Default number of solid voxels: 100 modes of it solve in seconds.
 pub const DEFAULT_ELEMENTS: usize = 20_000;
 
+/// Most modes one solve finds.
+pub const MAX_MODES: usize = 500;
+
 /// The Lanczos shift, `-(2 pi 20 Hz)^2`: below every audible mode and below the rigid motions'
 /// zero, so `K - sigma M` is positive definite.
 const SHIFT_HZ: f64 = 20.0;
@@ -395,10 +398,10 @@ pub fn solve_modes(
 impl MeshSettings {
     /// `Ok` when the settings can be solved.
     fn check(&self) -> Result<(), MeshError> {
-        if self.modes == 0 {
+        if !(1..=MAX_MODES).contains(&self.modes) {
             return Err(MeshError::BadSetting {
                 name: "modes",
-                reason: "expected at least 1".to_string(),
+                reason: format!("expected 1 to {MAX_MODES}, found {}", self.modes),
             });
         }
         if self.elements < 8 {

@@ -6,7 +6,8 @@
 //! common frequency scale (a mesh's material constants are rarely exact) from the strongest
 //! modes, then each recorded mode, strongest first, with the unpaired mesh mode nearest it in
 //! frequency among those the recorded point can excite, within a tolerance; pairs that cross in
-//! frequency order are undone. A paired mode keeps the recording's frequency, decay and gain at
+//! frequency order are undone. A second pass pairs again around a ratio that drifts with
+//! frequency, fitted to the first pass's pairs, and is kept if it pairs at least as many. A paired mode keeps the recording's frequency, decay and gain at
 //! the recorded point, and the mesh's gain ratio to that point everywhere else. A recorded mode
 //! left unpaired keeps its recorded gain at every point (the "minimum impulse response" of seed
 //! 000 section 6.2.3). A mesh mode silent at the recorded point, which the recording could not
@@ -20,6 +21,10 @@ const PAIR_TOLERANCE: f64 = 0.03;
 /// A mesh mode is excited at a point when its gain there is within this many dB of its largest.
 const EXCITED_DB: f64 = -30.0;
 
+/// A pair whose log frequency ratio lies farther than this from the fitted line is a chance
+/// pairing (about 1 %).
+const LINE_OUTLIER: f64 = 0.01;
+
 /// The recorded modes whose frequency ratios to mesh modes propose a scale: the strongest few.
 const SCALE_PROPOSERS: usize = 6;
 
@@ -29,14 +34,18 @@ const SCALE_RANGE: (f64, f64) = (0.5, 2.0);
 /// What the combination did.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MatchReport {
-    /// The recording's frequencies over the mesh's, for the pairs.
+    /// The recording's frequencies over the mesh's at the mesh's lowest mode.
     pub frequency_scale: f64,
+    /// How that ratio's logarithm changes per octave (0 when it is one constant).
+    pub scale_per_octave: f64,
     /// Recorded modes paired with mesh modes.
     pub paired: usize,
     /// Recorded modes left unpaired (recorded gain at every point).
     pub unpaired_recorded: usize,
     /// Mesh modes kept because the recorded point cannot excite them.
     pub kept_from_mesh: usize,
+    /// Mesh modes the recorded point excites that the recording lacks, left out.
+    pub dropped_from_mesh: usize,
 }
 
 /// Largest absolute gain of a mode over its positions.
@@ -87,9 +96,78 @@ fn frequency_scale(mesh: &Bank, recorded: &[Mode], at: usize) -> f64 {
     best.1
 }
 
+/// The recorded-to-mesh frequency ratio as a function of the mesh mode's frequency: a straight
+/// line in logarithms, `ln s = intercept + slope ln f` (a constant first; then fitted to the
+/// pairs, since a mesh's error grows with frequency: a voxel grid's stiffness, a missing
+/// detail).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct ScaleLine {
+    /// `ln s` at 1 Hz.
+    intercept: f64,
+    /// Change of `ln s` per unit of `ln f`.
+    slope: f64,
+}
+
+impl ScaleLine {
+    /// The same ratio at every frequency.
+    fn constant(scale: f64) -> Self {
+        Self {
+            intercept: scale.ln(),
+            slope: 0.0,
+        }
+    }
+
+    /// The ratio for a mesh mode at `freq_hz`.
+    fn scale(self, freq_hz: f64) -> f64 {
+        (self.intercept + self.slope * freq_hz.ln()).exp()
+    }
+
+    /// The least-squares line through the pairs' log ratios, the pair farthest from it dropped
+    /// and the line fitted again while that pair is more than [`LINE_OUTLIER`] off (a chance
+    /// pairing within the first pass's wide tolerance); `None` for fewer than three pairs.
+    fn fit(mesh: &Bank, recorded: &[Mode], pairs: &[(usize, usize)]) -> Option<Self> {
+        let mut points: Vec<(f64, f64)> = pairs
+            .iter()
+            .map(|&(k, j)| {
+                let f = mesh.modes[j].freq_hz;
+                (f.ln(), (recorded[k].freq_hz / f).ln())
+            })
+            .collect();
+        loop {
+            let line = Self::least_squares(&points)?;
+            let residual = |&(x, y): &(f64, f64)| (y - line.intercept - line.slope * x).abs();
+            let worst = (0..points.len())
+                .max_by(|&a, &b| residual(&points[a]).total_cmp(&residual(&points[b])))?;
+            if residual(&points[worst]) <= LINE_OUTLIER || points.len() <= 3 {
+                return Some(line);
+            }
+            points.remove(worst);
+        }
+    }
+
+    /// The least-squares line through `(ln f, ln s)` points; `None` for fewer than three.
+    fn least_squares(points: &[(f64, f64)]) -> Option<Self> {
+        if points.len() < 3 {
+            return None;
+        }
+        let n = points.len() as f64;
+        let (mx, my) = points
+            .iter()
+            .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+        let sxx: f64 = points.iter().map(|(x, _)| (x - mx).powi(2)).sum();
+        let sxy: f64 = points.iter().map(|(x, y)| (x - mx) * (y - my)).sum();
+        let slope = if sxx > 0.0 { sxy / sxx } else { 0.0 };
+        Some(Self {
+            intercept: my - slope * mx,
+            slope,
+        })
+    }
+}
+
 /// Pairs `(recorded index, mesh index)`: strongest recorded first, nearest excited mesh mode
-/// within the tolerance, then pairs out of frequency order undone (the weaker of two).
-fn pairs(mesh: &Bank, recorded: &[Mode], at: usize, scale: f64) -> Vec<(usize, usize)> {
+/// within the tolerance of the ratio `line` predicts, then pairs out of frequency order undone
+/// (the weaker of two).
+fn pairs(mesh: &Bank, recorded: &[Mode], at: usize, line: ScaleLine) -> Vec<(usize, usize)> {
     let mut order: Vec<usize> = (0..recorded.len()).collect();
     order.sort_by(|&a, &b| largest(&recorded[b]).total_cmp(&largest(&recorded[a])));
     let mut taken = vec![false; mesh.modes.len()];
@@ -98,7 +176,10 @@ fn pairs(mesh: &Bank, recorded: &[Mode], at: usize, scale: f64) -> Vec<(usize, u
         let f = recorded[k].freq_hz;
         let nearest = (0..mesh.modes.len())
             .filter(|&j| !taken[j] && excited(&mesh.modes[j], at))
-            .map(|j| (j, (f / (scale * mesh.modes[j].freq_hz)).ln().abs()))
+            .map(|j| {
+                let mesh_hz = mesh.modes[j].freq_hz;
+                (j, (f / (line.scale(mesh_hz) * mesh_hz)).ln().abs())
+            })
             .filter(|&(_, d)| d < PAIR_TOLERANCE.ln_1p())
             .min_by(|a, b| a.1.total_cmp(&b.1));
         if let Some((j, _)) = nearest {
@@ -121,7 +202,18 @@ fn pairs(mesh: &Bank, recorded: &[Mode], at: usize, scale: f64) -> Vec<(usize, u
 pub fn combine_with_recording(mesh: &Bank, recorded: &[Mode], at: usize) -> (Bank, MatchReport) {
     let positions = mesh.positions.len();
     let scale = frequency_scale(mesh, recorded, at);
-    let pairs = pairs(mesh, recorded, at, scale);
+    let first = pairs(mesh, recorded, at, ScaleLine::constant(scale));
+    let (line, pairs) = match ScaleLine::fit(mesh, recorded, &first) {
+        Some(line) => {
+            let second = pairs(mesh, recorded, at, line);
+            if second.len() >= first.len() {
+                (line, second)
+            } else {
+                (ScaleLine::constant(scale), first)
+            }
+        }
+        None => (ScaleLine::constant(scale), first),
+    };
     let floor = 10f64.powf(EXCITED_DB / 20.0);
     let mut modes = Vec::new();
     let mut levels = Vec::new();
@@ -160,16 +252,21 @@ pub fn combine_with_recording(mesh: &Bank, recorded: &[Mode], at: usize) -> (Ban
     }
     levels.sort_by(f64::total_cmp);
     let level = levels.get(levels.len() / 2).copied().unwrap_or(0.0);
-    let mut kept = 0;
+    let (mut kept, mut dropped) = (0, 0);
     let paired_mesh: Vec<usize> = pairs.iter().map(|&(_, j)| j).collect();
     for (j, m) in mesh.modes.iter().enumerate() {
-        if paired_mesh.contains(&j) || excited(m, at) || level == 0.0 {
+        if paired_mesh.contains(&j) {
+            continue;
+        }
+        if excited(m, at) || level == 0.0 {
+            dropped += 1; // the recording should hold it, and does not
             continue;
         }
         kept += 1;
+        let s = line.scale(m.freq_hz);
         modes.push(Mode {
-            freq_hz: m.freq_hz * scale,
-            decay_per_s: m.decay_per_s * scale,
+            freq_hz: m.freq_hz * s,
+            decay_per_s: m.decay_per_s * s,
             gains: m.gains.iter().map(|g| g * level).collect(),
         });
     }
@@ -178,11 +275,18 @@ pub fn combine_with_recording(mesh: &Bank, recorded: &[Mode], at: usize) -> (Ban
     bank.modes = modes;
     bank.root_hz = None;
     bank.root_hz = Some(bank.effective_root_hz());
+    let lowest_hz = mesh
+        .modes
+        .iter()
+        .map(|m| m.freq_hz)
+        .fold(f64::INFINITY, f64::min);
     let report = MatchReport {
-        frequency_scale: scale,
+        frequency_scale: line.scale(lowest_hz),
+        scale_per_octave: line.slope * std::f64::consts::LN_2,
         paired: pairs.len(),
         unpaired_recorded: unpaired.len(),
         kept_from_mesh: kept,
+        dropped_from_mesh: dropped,
     };
     (bank, report)
 }

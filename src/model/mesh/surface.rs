@@ -49,10 +49,16 @@ impl Surface {
     }
 
     /// Lowest and highest corner of the axis-aligned box around the surface.
+    /// Vertices no triangle uses (common in exported files) are not part of the surface.
     pub fn bounds(&self) -> ([f64; 3], [f64; 3]) {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
-        for v in &self.vertices {
+        let used = self
+            .triangles
+            .iter()
+            .flatten()
+            .filter_map(|&v| self.vertices.get(v as usize));
+        for v in used {
             for axis in 0..3 {
                 lo[axis] = lo[axis].min(v[axis]);
                 hi[axis] = hi[axis].max(v[axis]);
@@ -100,6 +106,12 @@ impl Surface {
             });
         }
         let scale = self.diagonal_m();
+        if !scale.is_finite() {
+            return Err(MeshError::BadSetting {
+                name: "scale",
+                reason: "the mesh's coordinates overflow once scaled to metres".to_string(),
+            });
+        }
         let mut edges: HashMap<(u32, u32), Vec<(usize, bool)>> = HashMap::new();
         for (t, tri) in self.triangles.iter().enumerate() {
             if let Some(&v) = tri.iter().find(|&&v| v as usize >= self.vertices.len()) {

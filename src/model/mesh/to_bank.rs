@@ -5,7 +5,7 @@ use serde_json::{json, Map, Value};
 
 use super::surface::{norm, sub, Surface};
 use super::{MeshError, MeshModes, MeshSettings};
-use crate::model::materials::{Material, AIR_DAMPING_PER_S};
+use crate::model::materials::AIR_DAMPING_PER_S;
 use crate::model::shapes::{finish_modes, solid_contact_ms, ModeLimits, ShapeError, ShapedMode};
 use crate::model::{Bank, BankDefaults, Position};
 
@@ -162,7 +162,7 @@ pub fn bank_from_modes(
     bank.license = "CC0-1.0".to_string();
     bank.modes = bank_modes;
     bank.root_hz = Some(bank.effective_root_hz());
-    bank.source = Some(source_record(modes, material, source));
+    bank.source = Some(source_record(modes, settings, source));
     bank.defaults = Some(BankDefaults {
         hardness_ms: Some(solid_contact_ms(material.class)),
         ..BankDefaults::default()
@@ -173,9 +173,10 @@ pub fn bank_from_modes(
 /// The bank's `source`: the mesh, the material, the solver and the element counts.
 fn source_record(
     modes: &MeshModes,
-    material: &Material,
+    settings: &MeshSettings,
     source: &MeshSource,
 ) -> Map<String, Value> {
+    let material = &settings.material;
     let stats = &modes.stats;
     let mut record = Map::new();
     record.insert("kind".into(), json!("mesh"));
@@ -201,6 +202,15 @@ fn source_record(
         json!(modes.voxels.size_m.map(|s| (s * 1e7).round() / 1e4)),
     );
     record.insert("degrees_of_freedom".into(), json!(stats.dofs));
+    record.insert("modes_sought".into(), json!(settings.modes));
+    record.insert(
+        "clamped".into(),
+        json!(settings
+            .clamps
+            .iter()
+            .map(|c| format!("{c:?}"))
+            .collect::<Vec<_>>()),
+    );
     record.insert("rigid_modes".into(), json!(stats.rigid_modes));
     record
 }
