@@ -278,7 +278,8 @@ impl PositionMap {
 }
 
 /// Points in space seen in the plane of their two widest spreads (the principal axes of their
-/// scatter, the widest first), as 2-D coordinates from their mean.
+/// scatter, the widest first), as 2-D coordinates from their mean; points on one line as 1-D
+/// coordinates along it.
 fn project_onto_widest_plane(coords: &[Vec<f64>]) -> Vec<Vec<f64>> {
     let point = |c: &Vec<f64>| [0, 1, 2].map(|a| c.get(a).copied().unwrap_or(0.0));
     let n = coords.len().max(1) as f64;
@@ -298,11 +299,17 @@ fn project_onto_widest_plane(coords: &[Vec<f64>]) -> Vec<Vec<f64>> {
     let (values, vectors) = symmetric_eigen3(scatter);
     let mut order = [0, 1, 2];
     order.sort_by(|&a, &b| values[b].total_cmp(&values[a]));
+    // Points on one line have no second axis (rounding must not make one up): a line.
+    let axes = if values[order[1]] <= 1e-12 * values[order[0]] {
+        1
+    } else {
+        2
+    };
     coords
         .iter()
         .map(|c| {
             let p = point(c);
-            order[..2]
+            order[..axes]
                 .iter()
                 .map(|&k| (0..3).map(|a| (p[a] - mean[a]) * vectors[a][k]).sum())
                 .collect()
@@ -430,6 +437,26 @@ mod tests {
             assert_eq!(w.index[0], k, "{w:?}");
             assert!(w.weight[0] > 0.9999, "{w:?}");
         }
+    }
+
+    #[test]
+    fn points_in_space_on_one_line_have_one_axis() {
+        // Along a slanted line: the strike moves along it, not across it.
+        let map = PositionMap::new(&[
+            vec![0.0, 0.0, 0.0],
+            vec![0.1, 0.03, 0.07],
+            vec![0.3, 0.09, 0.21],
+        ]);
+        assert_eq!(map.dims(), 1);
+        assert!(map.moves_along(0));
+        assert!(!map.moves_along(1));
+        // The ends at the ends (which one at 0 is the axis's sign), the middle a third along.
+        let x: Vec<f64> = map.coords().iter().map(|c| c[0]).collect();
+        assert!((x[0] - x[2]).abs() > 1.0 - 1e-12, "{x:?}");
+        assert!((x[1] - (2.0 * x[0] + x[2]) / 3.0).abs() < 1e-9, "{x:?}");
+        let end = if x[2] > 0.5 { 1.0 } else { 0.0 };
+        assert_eq!(map.weights(end, 0.3), PositionWeights::single(2));
+        assert_eq!(map.weights(1.0 - end, 0.9), PositionWeights::single(0));
     }
 
     #[test]
