@@ -18,12 +18,20 @@ const BAR_M: [f64; 3] = [0.3, 0.03, 0.01];
 /// `beta_n L` of a free-free beam's first four bending modes.
 const FREE_BEAM_ROOTS: [f64; 4] = [4.730_041, 7.853_205, 10.995_608, 14.137_165];
 
-fn solve(surface: &Surface, elements: usize, clamps: Vec<Clamp>, modes: usize) -> MeshModes {
-    let settings = MeshSettings {
+/// Steel, free, at `elements` voxels and `modes` modes.
+fn steel(elements: usize, modes: usize) -> MeshSettings {
+    MeshSettings {
         material: STEEL,
         elements,
-        clamps,
+        clamps: vec![],
         modes,
+    }
+}
+
+fn solve(surface: &Surface, elements: usize, clamps: Vec<Clamp>, modes: usize) -> MeshModes {
+    let settings = MeshSettings {
+        clamps,
+        ..steel(elements, modes)
     };
     solve_modes(surface, &settings, &mut |_| {}).expect("the mesh solves")
 }
@@ -219,12 +227,7 @@ fn a_bar_s_gain_is_zero_at_its_nodes_and_largest_at_its_ends() {
             p.normal
         );
     }
-    let settings = MeshSettings {
-        material: STEEL,
-        elements: 6000,
-        clamps: vec![],
-        modes: 4,
-    };
+    let settings = steel(6000, 4);
     let source = MeshSource {
         file_name: "bar.obj".to_string(),
         sha256: "0".repeat(64),
@@ -379,12 +382,7 @@ fn error_of(text: &str, name: &str) -> MeshError {
         Ok(surface) => surface,
         Err(e) => return e,
     };
-    let settings = MeshSettings {
-        material: STEEL,
-        elements: 100,
-        clamps: vec![],
-        modes: 4,
-    };
+    let settings = steel(100, 4);
     solve_modes(&surface, &settings, &mut |_| {}).expect_err("a bad mesh is refused")
 }
 
@@ -472,12 +470,7 @@ fn bad_meshes_are_refused_with_what_is_wrong_and_where() {
 
     // Huge: more elements than can be solved.
     let surface = generate::cuboid([1.0, 1.0, 1.0]);
-    let settings = MeshSettings {
-        material: STEEL,
-        elements: 1_000_000,
-        clamps: vec![],
-        modes: 4,
-    };
+    let settings = steel(1_000_000, 4);
     let error = solve_modes(&surface, &settings, &mut |_| {}).expect_err("too large");
     assert!(
         matches!(
@@ -498,12 +491,7 @@ fn bad_meshes_are_refused_with_what_is_wrong_and_where() {
         .extend(other.vertices.iter().map(|v| [v[0] + 0.02, v[1], v[2]]));
     two.triangles
         .extend(other.triangles.iter().map(|t| t.map(|v| v + offset)));
-    let settings = MeshSettings {
-        material: STEEL,
-        elements: 500,
-        clamps: vec![],
-        modes: 4,
-    };
+    let settings = steel(500, 4);
     let error = solve_modes(&two, &settings, &mut |_| {}).expect_err("two pieces");
     assert!(
         matches!(error, MeshError::Pieces { pieces: 2, .. }),
@@ -600,12 +588,7 @@ fn a_mesh_matched_to_a_recording_at_one_point_has_the_object_s_gains_at_the_othe
             point_m: [x * l, 0.5 * w, t],
         })
         .collect();
-    let settings = MeshSettings {
-        material: STEEL,
-        elements: 6000,
-        clamps: vec![],
-        modes: 30,
-    };
+    let settings = steel(6000, 30);
     let source = MeshSource {
         file_name: "bar.obj".to_string(),
         sha256: "0".repeat(64),

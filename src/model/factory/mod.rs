@@ -239,16 +239,18 @@ pub fn factory_bank(name_or_slug: &str) -> Option<Bank> {
     {
         return Some(object.build());
     }
-    let fitted = FITTED_PRESETS.iter().find_map(|preset| {
-        let bank = preset.bank();
-        (factory_slug(&bank) == wanted || preset.stem() == wanted).then_some(bank)
-    });
-    fitted.or_else(|| {
-        MESHED_PRESETS.iter().find_map(|preset| {
-            let bank = preset.bank();
-            (factory_slug(&bank) == wanted || preset.stem() == wanted).then_some(bank)
-        })
-    })
+    // Built-in files, fitted then meshed, as (bank, file stem).
+    let files = FITTED_PRESETS
+        .iter()
+        .map(|preset| (preset.bank(), preset.stem()))
+        .chain(
+            MESHED_PRESETS
+                .iter()
+                .map(|preset| (preset.bank(), preset.stem())),
+        );
+    files
+        .into_iter()
+        .find_map(|(bank, stem)| (factory_slug(&bank) == wanted || stem == wanted).then_some(bank))
 }
 
 /// Where the factory bank's file is, relative to `presets/`: `<slug>.json` for an analytic bank,
