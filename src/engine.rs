@@ -406,6 +406,9 @@ pub struct Engine {
     ended: Vec<EndedVoice>,
     /// Sample offset within the current `process` call.
     block_pos: u32,
+    /// Most voices sounding at once since [`Engine::take_peak_voices`] was last called,
+    /// counted as notes strike, so a voice struck and ended within one block counts.
+    peak_voices: usize,
     /// Perceptual pruning.
     pruner: Pruner,
     /// The computation budget.
@@ -455,6 +458,7 @@ impl Engine {
             excitation: Vec::new(),
             ended: Vec::new(),
             block_pos: 0,
+            peak_voices: 0,
             pruner: Pruner::new(),
             budget: budget::Budget::default(),
         }
@@ -627,6 +631,14 @@ impl Engine {
     /// Sample rate in Hz.
     pub fn sample_rate_hz(&self) -> f32 {
         self.sample_rate_hz as f32
+    }
+
+    /// The most voices that sounded at once since the last call (or since the engine was
+    /// prepared), counting a voice struck and ended within one block; starts the count again
+    /// from the voices sounding now. For a render's summary; does not allocate.
+    pub fn take_peak_voices(&mut self) -> usize {
+        let now = self.voices.iter().filter(|v| v.is_sounding()).count();
+        std::mem::replace(&mut self.peak_voices, now).max(now)
     }
 
     /// Meters.

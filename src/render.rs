@@ -16,7 +16,7 @@ use std::sync::Arc;
 
 pub use midi_file::{read_midi_file, TimedMidi};
 pub use notes::{parse_notes, Note};
-pub use wav::{to_int_sample, wav_bytes, write_wav, BitDepth, WavFile};
+pub use wav::{to_int_sample, wav_bytes, write_wav, BitDepth, WavEncoder, WavFile};
 
 use crate::dsp::ExciterKind;
 use crate::engine::{
@@ -162,7 +162,7 @@ pub enum RenderError {
         /// The file.
         path: PathBuf,
         /// What went wrong.
-        source: hound::Error,
+        source: std::io::Error,
     },
 }
 
@@ -537,7 +537,7 @@ pub fn render_to<'a, E>(
         r.fill(0.0);
         engine.process(&block_events, None, l, r);
         out.push(l, r)?;
-        max_voices = max_voices.max(engine.stats().voices);
+        max_voices = max_voices.max(engine.take_peak_voices());
         pos += len;
         done = done.max((pos as f64 / estimated_len).min(0.99));
         progress(done);

@@ -14,7 +14,7 @@ use modal_resonator::engine::{MidiMessage as EngineMidi, PreparedBank};
 use modal_resonator::model::Bank;
 use modal_resonator::render::{
     parse_notes, read_midi_file, render, to_int_sample, write_wav, BitDepth, Note, RenderSettings,
-    Rendered, TAIL_MARGIN_S,
+    Rendered, WavFile, TAIL_MARGIN_S,
 };
 
 const RATE: u32 = 48_000;
@@ -806,4 +806,89 @@ fn a_successful_write_replaces_an_existing_file() {
     assert_eq!(read.len(), 20);
     assert_eq!(&read[..2], &[0.25, -0.25]);
     assert_eq!(dir_entries(dir.path()), ["out.wav"]);
+}
+
+/// The little-endian integer of `N` bytes at `at`.
+fn le(bytes: &[u8], at: usize, n: usize) -> u64 {
+    bytes[at..at + n]
+        .iter()
+        .rev()
+        .fold(0, |v, &b| (v << 8) | u64::from(b))
+}
+
+#[test]
+fn data_past_the_riff_limit_is_written_as_rf64_not_wrapped() {
+    // The limit is lowered to 1,000 bytes for the test: 4 GiB cannot be written here.
+    let dir = tempfile::tempdir().unwrap();
+    let frames = 300usize;
+    let left: Vec<f32> = (0..frames).map(|i| i as f32 / 1024.0).collect();
+    let right: Vec<f32> = left.iter().map(|x| -x).collect();
+    for (depth, rf64) in [
+        (BitDepth::Int16, false),
+        (BitDepth::Int16, true),
+        (BitDepth::Int24, true),
+        (BitDepth::Float32, true),
+    ] {
+        let path = dir.path().join(format!("{}-{rf64}.wav", depth.bits()));
+        let mut file = WavFile::create(&path, depth, RATE).unwrap();
+        if rf64 {
+            file = file.with_rf64_above(1_000);
+        }
+        file.write(&left, &right).unwrap();
+        file.finish().unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let data_bytes = (frames * 2 * usize::from(depth.bits() / 8)) as u64;
+        let data_at = bytes.len() - data_bytes as usize;
+        assert_eq!(&bytes[data_at - 8..data_at - 4], b"data");
+        if rf64 {
+            // EBU Tech 3306: RF64, sizes of 0xFFFFFFFF, the true ones in ds64 right after WAVE.
+            assert_eq!(&bytes[..4], b"RF64", "{}-bit", depth.bits());
+            assert_eq!(le(&bytes, 4, 4), u64::from(u32::MAX));
+            assert_eq!(&bytes[8..16], b"WAVEds64");
+            assert_eq!(le(&bytes, 16, 4), 28);
+            assert_eq!(le(&bytes, 20, 8), bytes.len() as u64 - 8, "RIFF size");
+            assert_eq!(le(&bytes, 28, 8), data_bytes, "data size");
+            assert_eq!(le(&bytes, 36, 8), frames as u64, "sample count");
+            assert_eq!(le(&bytes, data_at - 4, 4), u64::from(u32::MAX));
+        } else {
+            // Under the limit: a plain WAV that other readers open, the reserved chunk skipped.
+            assert_eq!(&bytes[..4], b"RIFF");
+            assert_eq!(&bytes[12..16], b"JUNK");
+            let read: Vec<i16> = hound::WavReader::open(&path)
+                .unwrap()
+                .samples::<i16>()
+                .map(Result::unwrap)
+                .collect();
+            assert_eq!(read.len(), 2 * frames);
+            assert_eq!(read[2 * 299], to_int_sample(left[299], 16) as i16);
+            assert_eq!(read[2 * 299 + 1], to_int_sample(right[299], 16) as i16);
+        }
+        // The samples are the same either way.
+        let sample = |i: usize| -> f64 {
+            let width = usize::from(depth.bits() / 8);
+            let at = data_at + i * width;
+            match depth {
+                BitDepth::Float32 => {
+                    f32::from_le_bytes(bytes[at..at + 4].try_into().unwrap()) as f64
+                }
+                _ => {
+                    let raw = le(&bytes, at, width) as i64;
+                    let signed = (raw << (64 - 8 * width)) >> (64 - 8 * width);
+                    signed as f64 / (1i64 << (8 * width - 1)) as f64
+                }
+            }
+        };
+        for i in [0, 1, 2 * 150, 2 * 150 + 1, 2 * 299 + 1] {
+            let expected = if i % 2 == 0 {
+                left[i / 2]
+            } else {
+                right[i / 2]
+            } as f64;
+            assert!(
+                (sample(i) - expected).abs() < 1e-4,
+                "{}-bit sample {i}",
+                depth.bits()
+            );
+        }
+    }
 }

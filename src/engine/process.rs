@@ -408,6 +408,8 @@ impl Engine {
                 self.strike(i, p);
             }
         }
+        let sounding = self.voices.iter().filter(|v| v.is_sounding()).count();
+        self.peak_voices = self.peak_voices.max(sounding);
     }
 
     /// Strikes voice `i` with the engine's controls and the voice's own.
