@@ -478,6 +478,24 @@ fn a_recording_too_short_to_measure_is_an_error() {
 }
 
 #[test]
+fn a_recording_shorter_than_a_fit_needs_is_too_short_not_noise() {
+    // 100 samples of a strike: a decaying tone, no lead-in.
+    let samples: Vec<f32> = (0..100)
+        .map(|n| {
+            let t = n as f64 / RATE as f64;
+            (0.5 * (-30.0 * t).exp() * (std::f64::consts::TAU * 440.0 * t).sin()) as f32
+        })
+        .collect();
+    let error = fit_bank(
+        &[Recording::new("hit", samples, RATE)],
+        &FitOptions::default(),
+    )
+    .unwrap_err();
+    assert!(matches!(error, FitError::TooShort { .. }), "{error}");
+    assert!(!error.to_string().contains("noise"), "{error}");
+}
+
+#[test]
 fn clipped_and_very_noisy_recordings_fit_with_warnings() {
     let bank = truth_bank();
     // Driven into a converter that clips at full scale: a little too hot clips the start of the
@@ -803,6 +821,104 @@ fn hum_before_the_strike_is_left_out_and_a_slow_mode_from_the_strike_is_kept() {
             .iter()
             .any(|w| w.contains("60.0 Hz left out as hum") && w.contains("before the strike")),
         "{warnings:?}"
+    );
+}
+
+/// The most amplitude of a sinusoid at `freq_hz` in any Hann window of 4,096 samples (hop
+/// 2,048) of `x` from sample `from` on.
+fn most_amplitude_from(x: &[f64], from: usize, freq_hz: f64) -> f64 {
+    let len = 4096;
+    let w: Vec<f64> = (0..len)
+        .map(|n| 0.5 - 0.5 * (std::f64::consts::TAU * n as f64 / len as f64).cos())
+        .collect();
+    let omega = std::f64::consts::TAU * freq_hz / RATE as f64;
+    (from..x.len() - len)
+        .step_by(len / 2)
+        .map(|start| {
+            let (mut re, mut im) = (0.0, 0.0);
+            for (n, (v, w)) in x[start..start + len].iter().zip(&w).enumerate() {
+                re += v * w * (omega * n as f64).cos();
+                im -= v * w * (omega * n as f64).sin();
+            }
+            2.0 * (re * re + im * im).sqrt() / w.iter().sum::<f64>()
+        })
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn no_fitted_mode_rings_on_past_what_the_recording_shows() {
+    // The factory steel bar struck an octave under its root as `render` plays it (key 72, the
+    // left channel), its ring decaying into -70 dBFS of noise over 6 s, in 16 bits: weak modes
+    // the fits cannot follow into the noise must not be left at the decay floor, ringing for
+    // minutes where the recording shows nothing.
+    let bank = modal_resonator::model::factory::factory_bank("steel-free-free-bar").unwrap();
+    let seconds = 6.0;
+    let len = (seconds * RATE as f64) as usize;
+    let settings = modal_resonator::render::RenderSettings {
+        sample_rate_hz: RATE,
+        controls: Controls::for_bank(&bank),
+        max_seconds: seconds,
+        ..Default::default()
+    };
+    let played = render(
+        &Arc::new(PreparedBank::new(&bank)),
+        &[Note::new(72, 1.0, 0.2, None)],
+        &settings,
+        |_| {},
+    );
+    let sigma = 10f64.powf(-70.0 / 20.0);
+    let noise = gaussian_noise(len, 77);
+    let x: Vec<f64> = (0..len)
+        .map(|n| {
+            let v = played.left.get(n).copied().unwrap_or(0.0) as f64 + sigma * noise[n];
+            (v * 32767.0).round().clamp(-32768.0, 32767.0) / 32767.0
+        })
+        .collect();
+    let samples: Vec<f32> = x.iter().map(|&v| v as f32).collect();
+    let fit = fit_bank(
+        &[Recording::new("edge", samples, RATE)],
+        &FitOptions::default(),
+    )
+    .unwrap();
+    let tail = (0.75 * len as f64) as usize;
+    let t = tail as f64 / RATE as f64;
+    for m in &fit.bank.modes {
+        eprintln!(
+            "DEBUG {:.1} {:.3} {:.1} {:.1}",
+            m.freq_hz,
+            m.decay_per_s,
+            db(m.gains[0].abs() * (-m.decay_per_s * t).exp()),
+            db(most_amplitude_from(&x, tail, m.freq_hz))
+        );
+        // At the start of the last quarter a mode stands at most 12 dB over the most the
+        // recording holds at its frequency in that quarter (6 dB of the fit's margin, 6 of
+        // frames that differ from the fit's).
+        let level = m.gains[0].abs() * (-m.decay_per_s * t).exp();
+        let shown = most_amplitude_from(&x, tail, m.freq_hz);
+        assert!(
+            level < 4.0 * shown,
+            "{:.1} Hz decaying {:.3} /s (T60 {:.0} s) at {:.1} dBFS after {t:.1} s where the \
+             recording shows {:.1} dBFS",
+            m.freq_hz,
+            m.decay_per_s,
+            6.91 / m.decay_per_s,
+            db(level),
+            db(shown),
+        );
+    }
+    // The bar's own fundamental, an octave under its root, is still there with its slow decay
+    // (the bank's, played an octave down: half the rate).
+    let root = 0.5 * bank.root_hz.unwrap();
+    let fundamental = modes_near(&fit.bank, root, 1.0);
+    let loudest = fundamental
+        .iter()
+        .max_by(|a, b| a.gains[0].abs().total_cmp(&b.gains[0].abs()))
+        .unwrap_or_else(|| panic!("the fundamental {root} Hz left out"));
+    let truth = 0.5 * bank.modes[0].decay_per_s;
+    assert!(
+        (loudest.decay_per_s / truth - 1.0).abs() < 0.1,
+        "fundamental decays {} /s, played {truth} /s",
+        loudest.decay_per_s
     );
 }
 

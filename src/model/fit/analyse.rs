@@ -162,6 +162,7 @@ pub fn analyse(
     find_modes(&mut analysis, options, max_hz, progress);
     drop_steady_tones(&mut analysis);
     match_levels(&mut analysis, options.min_hz, max_hz);
+    decay_as_the_recording_shows(&mut analysis);
     // Matching levels can leave a mode far under the others.
     let sound_s = analysis.signal.len() as f64 / analysis.sample_rate_hz;
     drop_inaudible(&mut analysis.modes, sound_s, |m| {
@@ -190,6 +191,16 @@ pub fn prepare(recording: &Recording, options: &FitOptions) -> Result<Analysis, 
         });
     }
     let x: Vec<f64> = recording.samples.iter().map(|&v| v as f64).collect();
+    let needed = ((MIN_SOUND_S * rate) as usize).max(MIN_WINDOW * MIN_WINDOWS_IN_SOUND);
+    // A whole recording shorter than the sound a fit needs is too short, whatever it holds:
+    // too short as well to tell a strike from steady noise.
+    if x.len() < needed {
+        return Err(FitError::TooShort {
+            name,
+            found_s: x.len() as f64 / rate,
+            needed_s: needed as f64 / rate,
+        });
+    }
     let strike = find_strike(&x, rate).map_err(|detail| FitError::Silent {
         name: name.clone(),
         detail,
@@ -198,7 +209,6 @@ pub fn prepare(recording: &Recording, options: &FitOptions) -> Result<Analysis, 
     let max_len = (options.max_seconds * rate) as usize;
     let end = strike.end.min(strike.onset + max_len);
     let sound_len = end - strike.onset;
-    let needed = ((MIN_SOUND_S * rate) as usize).max(MIN_WINDOW * MIN_WINDOWS_IN_SOUND);
     if sound_len < needed {
         return Err(FitError::TooShort {
             name,
@@ -398,14 +408,86 @@ fn drop_steady_tones(a: &mut Analysis) {
 
 /// Amplitude of a sinusoid at `freq_hz` in the recording before the onset (Hann-windowed).
 fn amplitude_before(a: &Analysis, freq_hz: f64) -> f64 {
-    let w = hann(a.before.len());
-    let omega = std::f64::consts::TAU * freq_hz / a.sample_rate_hz;
-    let sum: Complex64 = a
-        .before
-        .iter()
-        .zip(&w)
-        .enumerate()
-        .map(|(n, (x, w))| Complex64::from_polar(x * w, -omega * n as f64))
-        .sum();
+    amplitude_in(&a.before, &hann(a.before.len()), a.sample_rate_hz, freq_hz)
+}
+
+/// Amplitude of a sinusoid at `freq_hz` in `x` under the window `w` (of `x`'s length).
+fn amplitude_in(x: &[f64], w: &[f64], sample_rate_hz: f64, freq_hz: f64) -> f64 {
+    let step = Complex64::from_polar(1.0, -std::f64::consts::TAU * freq_hz / sample_rate_hz);
+    let mut turn = Complex64::new(1.0, 0.0);
+    let mut sum = Complex64::new(0.0, 0.0);
+    for (x, w) in x.iter().zip(w) {
+        sum += turn * (x * w);
+        turn *= step;
+    }
     2.0 * sum.norm() / w.iter().sum::<f64>().max(1e-300)
+}
+
+/// The stretch at the end of the sound over which a mode's level is checked against the
+/// recording's, as a share of the sound: long enough that no beat of a close pair leaves it
+/// empty.
+const TAIL_SHARE: f64 = 0.25;
+
+/// How far a mode may stand above what the recording shows at its frequency in the tail, as an
+/// amplitude ratio (6 dB): a frame's level of noise or of a neighbour varies that much.
+const TAIL_MARGIN: f64 = 2.0;
+
+/// Makes every mode decay at least as fast as the recording shows it does. Over the last
+/// quarter of the sound, the resynthesis of all the modes may hold at a mode's frequency at most
+/// [`TAIL_MARGIN`] over the most the recording holds there in any frame (or the noise floor
+/// there, if higher); where it holds more, the mode, which rules the resynthesis there, decays
+/// faster until it does not. A weak mode the fits could not follow into the noise (its decay
+/// unmeasured, at the floor) would otherwise ring for minutes in every voice where the
+/// recording shows it gone within seconds. A mode still ringing at the end of a recording cut
+/// short keeps its decay, and a beating pair is judged by its sum, so a beat's null in the
+/// recording is one in the resynthesis too.
+fn decay_as_the_recording_shows(a: &mut Analysis) {
+    let rate = a.sample_rate_hz;
+    let len = a.window_len.min(a.signal.len());
+    let tail_start = ((1.0 - TAIL_SHARE) * a.signal.len() as f64) as usize;
+    if a.signal.len() < tail_start + len {
+        return;
+    }
+    let t = tail_start as f64 / rate;
+    // The resynthesis of the tail alone: each mode's complex amplitude carried to its start.
+    let shapes: Vec<Shape> = a
+        .modes
+        .iter()
+        .map(|m| Shape {
+            freq_hz: m.freq_hz,
+            decay_per_s: m.decay_per_s,
+        })
+        .collect();
+    let carried: Vec<Complex64> = a
+        .modes
+        .iter()
+        .map(|m| {
+            m.amplitude
+                * Complex64::from_polar(
+                    (-m.decay_per_s * t).exp(),
+                    std::f64::consts::TAU * m.freq_hz * t,
+                )
+        })
+        .collect();
+    let mut model = vec![0.0; a.signal.len() - tail_start];
+    add_modes(&mut model, rate, &shapes, &carried);
+    let window = hann(len);
+    let hop = (len / 2).max(1);
+    let most = |x: &[f64], f: f64| {
+        (0..=x.len() - len)
+            .step_by(hop)
+            .map(|n| amplitude_in(&x[n..n + len], &window, rate, f))
+            .fold(0.0, f64::max)
+    };
+    let tail = &a.signal[tail_start..];
+    for k in 0..a.modes.len() {
+        let f = a.modes[k].freq_hz;
+        let shown = most(tail, f).max(a.floor_amplitude(f));
+        let ratio = most(&model, f) / (TAIL_MARGIN * shown);
+        if ratio > 1.0 {
+            let m = &mut a.modes[k];
+            m.decay_per_s += ratio.ln() / t;
+            m.track.decay_per_s = m.decay_per_s;
+        }
+    }
 }
