@@ -259,7 +259,10 @@ fn a_bad_bank_file_fails_and_writes_nothing() {
     );
     assert_failed_cleanly(
         &out,
-        &["no bank file or factory preset named \"no-such-bank\""],
+        &[
+            "no factory bank named \"no-such-bank\" and no file",
+            "modal-resonator list",
+        ],
         dir.path(),
         &["broken.json", "wrong.json"],
     );
@@ -970,11 +973,17 @@ fn fit_never_overwrites_a_recording_and_a_late_failure_writes_nothing() {
                 "--report",
                 "./edge.wav",
             ][..],
-            &["edge.wav", "the report would overwrite this recording"][..],
+            &[
+                "--report ./edge.wav",
+                "would overwrite an input, the recording edge.wav",
+            ][..],
         ),
         (
             &["fit", "edge.wav", "-o", "edge.wav"][..],
-            &["edge.wav", "the bank would overwrite this recording"][..],
+            &[
+                "-o edge.wav",
+                "would overwrite an input, the recording edge.wav",
+            ][..],
         ),
         (
             &[
@@ -1406,12 +1415,281 @@ fn an_input_is_known_by_its_identity_not_its_name() {
         let out = run(d, &["compress", "bank.json", "-o", output]);
         assert!(!out.status.success(), "{output} overwrote the bank");
         assert!(
-            stderr(&out).contains("would overwrite the input"),
+            stderr(&out).contains("would overwrite an input, the bank bank.json"),
             "{output}: {}",
             stderr(&out)
         );
     }
     assert_eq!(std::fs::read(d.join("bank.json")).unwrap(), before);
+}
+
+#[test]
+fn no_command_writes_over_what_it_reads() {
+    let dir = dir_with_bank();
+    let d = dir.path();
+    write_box_stl(&d.join("box.stl"), [0.1, 0.02, 0.01]);
+    write_strike_wav(&d.join("rec.wav"), 1);
+    std::fs::hard_link(d.join("box.stl"), d.join("alias.json")).unwrap();
+    let kept = ["alias.json", "box.stl", "rec.wav"];
+    let originals: Vec<Vec<u8>> = ["bank.json", "box.stl", "rec.wav"]
+        .iter()
+        .map(|f| std::fs::read(d.join(f)).unwrap())
+        .collect();
+    let mesh = ["mesh", "box.stl", "--elements", "500", "--modes", "8"];
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        ([&mesh[..], &["-o", "box.stl"]].concat(), "the mesh box.stl"),
+        (
+            [&mesh[..], &["-o", "./alias.json"]].concat(),
+            "the mesh box.stl",
+        ),
+        (
+            [
+                &mesh[..],
+                &["--positions", "2", "--match", "rec.wav=p1", "-o", "rec.wav"],
+            ]
+            .concat(),
+            "the recording rec.wav",
+        ),
+        (
+            vec!["fit", "rec.wav", "-o", "rec.wav"],
+            "the recording rec.wav",
+        ),
+        (
+            vec!["compress", "bank.json", "-o", "bank.json"],
+            "the bank bank.json",
+        ),
+        (
+            vec![
+                "render",
+                "bank.json",
+                "--notes",
+                ONE_NOTE,
+                "-o",
+                "bank.json",
+            ],
+            "the bank bank.json",
+        ),
+    ];
+    for (args, input) in cases {
+        let out = run(d, &args);
+        assert_failed_cleanly(&out, &["would overwrite an input", input], d, &kept);
+    }
+    for (file, original) in ["bank.json", "box.stl", "rec.wav"].iter().zip(&originals) {
+        assert_eq!(
+            &std::fs::read(d.join(file)).unwrap(),
+            original,
+            "{file} changed"
+        );
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn an_output_that_cannot_be_written_is_refused_before_any_work() {
+    // Nobody, root included, may make a file in /sys.
+    let dir = dir_with_bank();
+    let d = dir.path();
+    write_box_stl(&d.join("box.stl"), [0.1, 0.02, 0.01]);
+    write_strike_wav(&d.join("rec.wav"), 1);
+    let out_path = "/sys/modal-resonator-out.json";
+    for args in [
+        vec![
+            "mesh",
+            "box.stl",
+            "--elements",
+            "500",
+            "--modes",
+            "8",
+            "-o",
+            out_path,
+        ],
+        vec!["fit", "rec.wav", "-o", out_path],
+        vec!["shape", "free-free-bar", "-o", out_path],
+        vec!["compress", "bank.json", "-o", out_path],
+        vec!["render", "bank.json", "--notes", ONE_NOTE, "-o", out_path],
+        vec!["fit", "rec.wav", "-o", "fit.json", "--report", out_path],
+    ] {
+        let out = run(d, &args);
+        let err = stderr(&out);
+        assert!(!out.status.success(), "{args:?} succeeded");
+        assert!(
+            err.contains(out_path) && err.contains("cannot write in directory /sys"),
+            "{args:?}: {err}"
+        );
+        assert!(
+            !err.contains(".tmp"),
+            "{args:?} names a temporary file: {err}"
+        );
+        // Nothing was solved, fitted or rendered first.
+        assert!(stdout(&out).is_empty(), "{args:?}: {}", stdout(&out));
+        assert_eq!(entries(d), ["bank.json", "box.stl", "rec.wav"], "{args:?}");
+    }
+}
+
+#[test]
+fn factory_names_are_not_hidden_and_missing_files_are_named() {
+    let dir = dir_with_bank();
+    let d = dir.path();
+    // A factory bank written under its own name is not "the input".
+    let out = run(
+        d,
+        &["compress", "bronze-flat-gong", "-o", "bronze-flat-gong"],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    // A render then names the output after the bank: the name still means the factory bank.
+    std::fs::write(d.join("bronze-bell"), b"RIFF not a bank").unwrap();
+    let out = run(d, &["info", "bronze-bell"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stdout(&out).contains("Bronze bell"), "{}", stdout(&out));
+    assert!(
+        stderr(&out).contains("write ./bronze-bell for the file"),
+        "{}",
+        stderr(&out)
+    );
+    let out = run(d, &["info", "./bronze-bell"]);
+    assert!(!out.status.success());
+    // A missing file is called missing, where it was looked for.
+    let out = run(
+        d,
+        &["render", "my-bank.json", "--notes", ONE_NOTE, "-o", "x.wav"],
+    );
+    let err = stderr(&out);
+    let looked = d.canonicalize().unwrap().join("my-bank.json");
+    assert!(
+        err.contains("my-bank.json: no such bank file") && err.contains(&*looked.to_string_lossy()),
+        "{err}"
+    );
+    assert!(!err.contains("celesta"), "lists every factory bank: {err}");
+    let out = run(d, &["info", "bronze-bel"]);
+    assert!(
+        stderr(&out).contains("did you mean bronze-bell"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn list_keeps_its_columns_and_the_docs_count_the_banks_it_lists() {
+    let out = run(Path::new("."), &["list"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = stdout(&out);
+    let lines: Vec<&str> = text.lines().collect();
+    // The modes column ends at the same place on every line, the longest slug's included.
+    let ends: Vec<usize> = lines.iter().map(|l| l.find(" modes").unwrap()).collect();
+    assert!(ends.iter().all(|&e| e == ends[0]), "{text}");
+    let count = lines.len();
+    assert_eq!(
+        count,
+        modal_resonator::model::factory::factory_banks().len()
+    );
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    assert!(
+        readme.contains(&format!("{count} banks are built in")),
+        "README.md"
+    );
+    let presets = std::fs::read_to_string(root.join("presets/README.md")).unwrap();
+    assert!(
+        presets.contains(&format!("ships {count} factory banks")),
+        "presets/README.md"
+    );
+}
+
+#[test]
+fn every_control_is_documented_for_render_set() {
+    let readme =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("README.md")).unwrap();
+    let start = readme
+        .find("- `--set name=value` sets any control")
+        .unwrap();
+    let list = &readme[start..start + readme[start..].find("\n- ").unwrap()];
+    for spec in modal_resonator::engine::NUMERIC_CONTROLS {
+        assert!(
+            list.contains(&format!("`{}`", spec.name)),
+            "{} is not documented",
+            spec.name
+        );
+    }
+}
+
+#[test]
+fn quiet_mistakes_are_refused_or_said() {
+    let dir = dir_with_bank();
+    let d = dir.path();
+    write_box_stl(&d.join("box.stl"), [0.1, 0.02, 0.01]);
+    let kept = ["box.stl"];
+    // A negative value reaches the option's own check, not clap's advice to write `-- -1`.
+    for (args, expected) in [
+        (
+            vec!["mesh", "box.stl", "--scale", "-1", "-o", "o.json"],
+            "expected a number above 0",
+        ),
+        (
+            vec!["render", "bank.json", "--notes", "-5:1@0", "-o", "o.wav"],
+            "expected a whole number from 0 to 127, found \"-5\"",
+        ),
+        (
+            vec![
+                "render",
+                "bank.json",
+                "--notes",
+                "69:1@0 speed=1",
+                "-o",
+                "o.wav",
+            ],
+            "speed= and force= drive a contact",
+        ),
+        (
+            vec!["mesh", "box.stl", "--loss-factor", "10", "-o", "o.json"],
+            "expected a loss factor above 0 and at most 0.5",
+        ),
+        (
+            vec![
+                "compress",
+                "bank.json",
+                "--limen-scale",
+                "1e9",
+                "-o",
+                "o.json",
+            ],
+            "--limen-scale 1000000000: expected a number from 0 to 10",
+        ),
+    ] {
+        let out = run(d, &args);
+        assert_failed_cleanly(&out, &[expected], d, &kept);
+        assert!(!stderr(&out).contains("tip:"), "{args:?}: {}", stderr(&out));
+    }
+    // A float render over full scale is written, and said to be.
+    let out = run(
+        d,
+        &[
+            "render",
+            "bank.json",
+            "--notes",
+            ONE_NOTE,
+            "--bits",
+            "32",
+            "--set",
+            "output_gain_db=12",
+            "-o",
+            "loud.wav",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("over full scale"), "{}", stderr(&out));
+    // A note too soft to ring on still counts as the voice it played.
+    let out = run(
+        d,
+        &[
+            "render",
+            "bank.json",
+            "--notes",
+            "69:0.001@0",
+            "-o",
+            "soft.wav",
+        ],
+    );
+    assert!(stdout(&out).contains("up to 1 voices"), "{}", stdout(&out));
 }
 
 #[test]

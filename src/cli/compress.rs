@@ -7,7 +7,7 @@ use clap::Args;
 
 use modal_resonator::model::compress::{compress_bank, CompressOptions, DEFAULT_DROP_BELOW_DB};
 
-use super::{check_output_dir, load_bank, output_name, same_file, save_bank_output, say};
+use super::{check_output, load_bank, output_name, save_bank_output, say};
 
 /// Arguments of `compress`.
 #[derive(Debug, Args)]
@@ -32,14 +32,14 @@ pub(super) struct CompressArgs {
 
 /// Compresses, saves atomically and prints what was removed. Nothing is written on failure.
 pub(super) fn run(args: &CompressArgs) -> Result<(), String> {
-    let bank = load_bank(&args.bank)?;
-    check_output_dir(&args.output)?;
-    if same_file(Path::new(&args.bank), &args.output) {
-        return Err(format!(
-            "{}: the output would overwrite the input",
-            args.output.display()
-        ));
-    }
+    let loaded = load_bank(&args.bank)?;
+    let inputs: Vec<(&str, &Path)> = loaded
+        .file
+        .iter()
+        .map(|f| ("the bank", f.as_path()))
+        .collect();
+    check_output("-o", &args.output, &inputs)?;
+    let bank = loaded.bank;
     let options = CompressOptions {
         limen_scale: args.limen_scale,
         drop_below_db: (!args.keep_weak).then_some(args.drop_below_db),

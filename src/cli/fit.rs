@@ -1,6 +1,6 @@
 //! `modal-resonator fit`: a bank from recordings of an object struck at one or more positions.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::Args;
 
@@ -12,7 +12,7 @@ use modal_resonator::model::{commit_all, stage_bank_file};
 use modal_resonator::model::validate::validate_bank;
 
 use super::progress::Progress;
-use super::{check_output_dir, is_stdout, output_name, same_file, save_bank_output, say};
+use super::{check_output, is_stdout, output_name, same_file, save_bank_output, say};
 
 /// Arguments of `fit`.
 #[derive(Debug, Args)]
@@ -64,9 +64,18 @@ pub(super) struct FitArgs {
 /// `fit`: reads every recording, fits, writes the bank (and the report if asked) and prints the
 /// report. Nothing is written on failure: both files are staged before either is put in place.
 pub(super) fn run(args: &FitArgs) -> Result<(), String> {
-    check_output_dir(&args.output)?;
+    let split: Vec<(PathBuf, String)> = args
+        .recordings
+        .iter()
+        .map(|arg| split_recording_arg(arg))
+        .collect();
+    let inputs: Vec<(&str, &Path)> = split
+        .iter()
+        .map(|(path, _)| ("the recording", path.as_path()))
+        .collect();
+    check_output("-o", &args.output, &inputs)?;
     if let Some(report) = &args.report {
-        check_output_dir(report)?;
+        check_output("--report", report, &inputs)?;
         if same_file(report, &args.output) {
             return Err(format!(
                 "{}: the report and the bank would be the same file; name another --report",
@@ -74,21 +83,9 @@ pub(super) fn run(args: &FitArgs) -> Result<(), String> {
             ));
         }
     }
-    let mut recordings = Vec::with_capacity(args.recordings.len());
-    for arg in &args.recordings {
-        let (path, position) = split_recording_arg(arg);
-        for (output, what) in [
-            (Some(&args.output), "bank"),
-            (args.report.as_ref(), "report"),
-        ] {
-            if output.is_some_and(|output| same_file(&path, output)) {
-                return Err(format!(
-                    "{}: the {what} would overwrite this recording; write it elsewhere",
-                    path.display()
-                ));
-            }
-        }
-        recordings.push(read_wav_recording(&path, &position).map_err(|e| e.to_string())?);
+    let mut recordings = Vec::with_capacity(split.len());
+    for (path, position) in &split {
+        recordings.push(read_wav_recording(path, position).map_err(|e| e.to_string())?);
     }
     let name = args.name.clone().unwrap_or_else(|| {
         let stem = args.output.file_stem().filter(|_| !is_stdout(&args.output));

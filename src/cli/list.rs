@@ -2,15 +2,30 @@
 
 use modal_resonator::model::factory::{factory_banks, factory_slug};
 
-/// Prints one line per factory bank: slug, number of modes, licence and name.
+/// Prints one line per factory bank: slug, number of modes, licence and name, in columns as
+/// wide as their longest entry.
 pub(super) fn run() -> Result<(), String> {
-    for bank in factory_banks() {
+    let rows: Vec<(String, usize, String, String)> = factory_banks()
+        .into_iter()
+        .map(|bank| {
+            (
+                factory_slug(&bank),
+                bank.modes.len(),
+                bank.license,
+                bank.name,
+            )
+        })
+        .collect();
+    let slug_width = rows.iter().map(|r| r.0.chars().count()).max().unwrap_or(0);
+    let modes_width = rows
+        .iter()
+        .map(|r| r.1.to_string().len())
+        .max()
+        .unwrap_or(0);
+    let license_width = rows.iter().map(|r| r.2.chars().count()).max().unwrap_or(0);
+    for (slug, modes, license, name) in rows {
         println!(
-            "{:<28} {:>5} modes  {:<17} {}",
-            factory_slug(&bank),
-            bank.modes.len(),
-            bank.license,
-            bank.name
+            "{slug:<slug_width$}  {modes:>modes_width$} modes  {license:<license_width$}  {name}"
         );
     }
     Ok(())

@@ -18,8 +18,8 @@ use modal_resonator::model::shapes::{ModeLimits, MAX_AUDIBLE_HZ};
 use modal_resonator::model::summary::note_name;
 
 use super::progress::Progress;
-use super::shape::{parse_material, parse_positive};
-use super::{check_output_dir, save_bank_output, say};
+use super::shape::{parse_loss_factor, parse_material, parse_positive};
+use super::{check_output, save_bank_output, say};
 
 /// A mesh file larger than this is refused before it is read.
 const MAX_MESH_FILE_BYTES: u64 = 512 << 20;
@@ -55,7 +55,7 @@ pub(super) struct MeshArgs {
     #[arg(long, value_parser = parse_poisson, value_name = "NU")]
     poisson: Option<f64>,
     /// Loss factor (1/Q of internal friction), instead of the material's.
-    #[arg(long, value_parser = parse_positive, value_name = "ETA")]
+    #[arg(long, value_parser = parse_loss_factor, value_name = "ETA")]
     loss_factor: Option<f64>,
     /// Held parts, repeatable: a plane as "z<0.002" or "x>0.25" (file units: everything on
     /// that side is clamped), or mesh vertices as "vertices=0,17,42" (0-based; the solid
@@ -96,7 +96,16 @@ pub(super) struct MeshArgs {
 
 /// Builds the bank, saves it atomically and prints what it is. Nothing is written on failure.
 pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
-    check_output_dir(&args.output)?;
+    let recording_file = args
+        .match_recording
+        .as_deref()
+        .and_then(|spec| spec.rsplit_once('='))
+        .map(|(path, _)| PathBuf::from(path.trim()));
+    let mut inputs = vec![("the mesh", args.input.as_path())];
+    if let Some(file) = &recording_file {
+        inputs.push(("the recording", file));
+    }
+    check_output("-o", &args.output, &inputs)?;
     let place = args.input.display().to_string();
     let (surface, source) = read_mesh(args)?;
     let mut settings = MeshSettings {

@@ -16,7 +16,7 @@ mod validate;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 use modal_resonator::model::factory::{factory_bank, factory_banks, factory_slug};
 use modal_resonator::model::staged::{destination, exit_removing_temporaries};
@@ -91,7 +91,8 @@ pub fn main() -> ExitCode {
             }),
         }
     } else {
-        Cli::parse()
+        let matches = parser().get_matches();
+        Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit())
     };
     let standalone = matches!(cli.command, Some(Command::Play { .. }) | None);
     if !standalone {
@@ -120,6 +121,21 @@ pub fn main() -> ExitCode {
     }
 }
 
+/// The command line's parser. Every option's value may be a negative number, so that
+/// `--scale -1` reaches the option's own check ("expected a number above 0") instead of
+/// clap's advice to write `-- -1`, which does not work for an option's value.
+fn parser() -> clap::Command {
+    Cli::command().mut_subcommands(|sub| {
+        sub.mut_args(|arg| {
+            if arg.get_action().takes_values() && !arg.is_positional() {
+                arg.allow_negative_numbers(true)
+            } else {
+                arg
+            }
+        })
+    })
+}
+
 /// Lets a closed output pipe end the process silently, as it ends `cat` (`info | head`),
 /// instead of making every later print fail. Not for the standalone, whose audio and MIDI
 /// connections must see a closed socket as an error.
@@ -139,20 +155,91 @@ fn clean_up_on_interrupt() {
     let _ = ctrlc::set_handler(|| exit_removing_temporaries(130));
 }
 
-/// Loads the bank named on the command line: a bank file (validated) if `arg` is a path that
-/// exists, else the factory bank of that name or slug.
-pub(super) fn load_bank(arg: &str) -> Result<Bank, String> {
+/// A bank named on the command line, and the file it came from (none for a factory bank).
+pub(super) struct LoadedBank {
+    /// The bank.
+    pub bank: Bank,
+    /// The file it was read from; `None` for a factory bank.
+    pub file: Option<PathBuf>,
+}
+
+/// Loads the bank named on the command line. A bare name of a factory bank (no directory, no
+/// extension) is that factory bank, even where a file of that name lies in the working
+/// directory (which is said, with how to name the file instead: `./NAME`); anything else is a
+/// bank file, validated. An error says which was looked for, and where.
+pub(super) fn load_bank(arg: &str) -> Result<LoadedBank, String> {
     let path = Path::new(arg);
-    if path.exists() {
-        return load_bank_file(path).map_err(|e| e.to_string());
+    let bare = path.components().count() == 1 && path.extension().is_none();
+    if bare {
+        if let Some(bank) = factory_bank(arg) {
+            if path.exists() {
+                eprintln!(
+                    "note: \"{arg}\" is a factory bank, played instead of the file of that name \
+                     here; write ./{arg} for the file"
+                );
+            }
+            return Ok(LoadedBank { bank, file: None });
+        }
     }
-    factory_bank(arg).ok_or_else(|| {
+    if path.exists() {
+        let bank = load_bank_file(path).map_err(|e| e.to_string())?;
+        return Ok(LoadedBank {
+            bank,
+            file: Some(path.to_path_buf()),
+        });
+    }
+    let looked_in = std::env::current_dir()
+        .map(|dir| dir.join(path).display().to_string())
+        .unwrap_or_else(|_| arg.to_string());
+    if bare {
         let names: Vec<String> = factory_banks().iter().map(factory_slug).collect();
-        format!(
-            "no bank file or factory preset named \"{arg}\"; factory presets: {}",
-            names.join(", ")
-        )
-    })
+        let near = nearest_names(arg, &names);
+        Err(format!(
+            "no factory bank named \"{arg}\" and no file {looked_in}{}; `modal-resonator list` \
+             shows the factory banks",
+            if near.is_empty() {
+                String::new()
+            } else {
+                format!(" (did you mean {}?)", near.join(", "))
+            }
+        ))
+    } else {
+        Err(format!(
+            "{arg}: no such bank file ({looked_in} does not exist)"
+        ))
+    }
+}
+
+/// The names among `names` closest to `wanted` by edit distance (at most a third of its
+/// length away), closest first, at most three.
+fn nearest_names(wanted: &str, names: &[String]) -> Vec<String> {
+    let wanted = wanted.to_lowercase();
+    let limit = wanted.chars().count().div_ceil(3).max(2);
+    let mut scored: Vec<(usize, &String)> = names
+        .iter()
+        .map(|name| (edit_distance(&wanted, name), name))
+        .filter(|(d, name)| *d <= limit || name.contains(wanted.as_str()))
+        .collect();
+    scored.sort();
+    scored.into_iter().take(3).map(|(_, n)| n.clone()).collect()
+}
+
+/// Levenshtein distance between two strings, by characters.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let above = row[j + 1];
+            row[j + 1] = (diagonal + usize::from(ca != cb))
+                .min(above + 1)
+                .min(row[j] + 1);
+            diagonal = above;
+        }
+    }
+    row[b.len()]
 }
 
 /// The output path that means standard output.
@@ -204,27 +291,62 @@ pub(super) fn output_name(output: &Path) -> String {
     }
 }
 
-/// Fails early, before a long render, when the output cannot be written: something other than
-/// a regular file is there (a directory, a device, a named pipe, a socket; a symbolic link is
-/// followed), or its directory does not exist.
-pub(super) fn check_output_dir(output: &Path) -> Result<(), String> {
+/// Checks, before any work, that a command can write `output` (named by the option `option`,
+/// such as `-o`): something other than a regular file there (a directory, a device, a named
+/// pipe, a socket; a symbolic link is followed) is refused, as is a directory that does not
+/// exist or cannot be written in (tried by making and removing a file there), and an output that
+/// is one of the command's `inputs` (each with what it is, such as "the bank"), by identity, so
+/// a hard or symbolic link to an input is refused too. Every command that writes a file calls
+/// it, so none can overwrite what it reads.
+pub(super) fn check_output(
+    option: &str,
+    output: &Path,
+    inputs: &[(&str, &Path)],
+) -> Result<(), String> {
     if is_stdout(output) {
         return Ok(());
     }
+    let shown = output.display();
     let target = destination(output).map_err(|e| {
         format!(
-            "{}: {e}; name a file to write{}",
-            output.display(),
+            "{option} {shown}: {e}; name a file to write{}",
             if output.is_dir() { " in it" } else { "" }
         )
     })?;
-    match target.path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => Err(format!(
-            "{}: directory {} does not exist",
-            output.display(),
+    for (what, input) in inputs {
+        if same_file(input, output) {
+            return Err(format!(
+                "{option} {shown}: would overwrite an input, {what} {}; write elsewhere",
+                input.display()
+            ));
+        }
+    }
+    let dir = match target.path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        return Err(format!(
+            "{option} {shown}: directory {} does not exist",
             dir.display()
+        ));
+    }
+    let probe = tempfile::Builder::new()
+        .prefix(".modal-resonator-probe-")
+        .tempfile_in(dir);
+    match probe {
+        Ok(file) => {
+            let _ = file.close();
+            Ok(())
+        }
+        Err(e) => Err(format!(
+            "{option} {shown}: cannot write in directory {}: {}",
+            dir.display(),
+            e.raw_os_error().map_or_else(
+                || e.kind().to_string(),
+                |code| { std::io::Error::from_raw_os_error(code).to_string() }
+            )
         )),
-        _ => Ok(()),
     }
 }
 

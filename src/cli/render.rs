@@ -15,7 +15,7 @@ use modal_resonator::render::{
 };
 
 use super::progress::Progress;
-use super::{check_output_dir, load_bank, same_file, STDOUT};
+use super::{check_output, load_bank, STDOUT};
 
 /// Arguments of `render`.
 #[derive(Debug, Args)]
@@ -26,7 +26,7 @@ pub(super) struct RenderArgs {
     /// Notes as key:velocity@time_s[+duration_s], comma-separated, e.g.
     /// "60:0.8@0, 64:0.5@0.25+0.5"; a contact note may add speed=A..B (m/s) and force=A..B,
     /// e.g. "60:1@0+2 speed=0.2..1.5".
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     notes: Option<String>,
     /// Standard MIDI file to play (all tracks and channels; bends, pedal, wheel, pressure and
     /// CC 74 as the plugins play them).
@@ -61,7 +61,16 @@ pub(super) const SILENT_EXIT: u8 = 3;
 /// render that clips is written with a warning; one that is silent is written with a warning
 /// and [`SILENT_EXIT`].
 pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
-    let bank = load_bank(&args.bank)?;
+    let loaded = load_bank(&args.bank)?;
+    let mut inputs: Vec<(&str, &Path)> = Vec::new();
+    if let Some(file) = &loaded.file {
+        inputs.push(("the bank", file));
+    }
+    if let Some(midi) = &args.midi {
+        inputs.push(("the MIDI file", midi));
+    }
+    check_output("-o", &args.output, &inputs)?;
+    let bank = loaded.bank;
     let mut controls = Controls::for_bank(&bank);
     for (name, value) in &args.set {
         controls
@@ -92,6 +101,20 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
         (None, Some(path)) => (Vec::new(), read_midi_file(path).map_err(|e| e.to_string())?),
         (None, None) => unreachable!("clap requires --notes or --midi"),
     };
+    if !controls.exciter.is_contact() {
+        if let Some(k) = notes
+            .iter()
+            .position(|n| n.speed_m_per_s.is_some() || n.force.is_some())
+        {
+            return Err(format!(
+                "--notes: note {}: speed= and force= drive a contact (scrape, roll, rub), but \
+                 this bank is struck (exciter {}); add --set exciter=scrape (or roll, rub) to \
+                 play it by a contact, or leave them out",
+                k + 1,
+                controls.exciter.name()
+            ));
+        }
+    }
     let score = if args.notes.is_some() {
         Score::Notes(&notes)
     } else {
@@ -104,18 +127,6 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
         ));
     }
     let to_stdout = args.output.as_os_str() == STDOUT;
-    if !to_stdout {
-        check_output_dir(&args.output)?;
-    }
-    let inputs = [Some(Path::new(&args.bank)), args.midi.as_deref()];
-    for input in inputs.into_iter().flatten() {
-        if !to_stdout && same_file(input, &args.output) {
-            return Err(format!(
-                "{}: the output would overwrite an input",
-                args.output.display()
-            ));
-        }
-    }
     let settings = RenderSettings {
         sample_rate_hz: args.rate,
         bit_depth: args.bits,
@@ -201,7 +212,8 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
     let silent = rendered.peak < 0.5 * args.bits.least_level();
 
     let peak_dbfs = rendered.peak_dbfs();
-    let clipped = args.bits != BitDepth::Float32 && rendered.peak > 1.0;
+    let over = rendered.peak > 1.0;
+    let clipped = args.bits != BitDepth::Float32 && over;
     // With the WAV on standard output, the summary goes to standard error.
     let summary = format!(
         "{}: {:.2} s, {} Hz {}, peak {:.1} dBFS{}, up to {} voices, rendered in {:.2} s{}",
@@ -236,6 +248,13 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
              --set output_gain_db=-6, or --bits 32 to keep the peaks",
             if clips == 1 { " is" } else { "s are" },
             args.bits.name()
+        );
+    }
+    if over && !clipped {
+        eprintln!(
+            "warning: the render peaks at {peak_dbfs:+.1} dBFS, over full scale: the float file \
+             keeps the peaks, but a player or a conversion to integers will clip them. Render \
+             again with --normalize -1 to bring the peak to -1 dBFS"
         );
     }
     if silent && score.first_note_from(0.0).is_none() {

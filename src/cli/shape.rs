@@ -13,7 +13,7 @@ use modal_resonator::model::summary::{note_name, note_to_midi_key};
 use modal_resonator::model::Position;
 use modal_resonator::units::{decay_to_t60_s, midi_key_to_hz};
 
-use super::{check_output_dir, output_name, save_bank_output, say};
+use super::{check_output, output_name, save_bank_output, say};
 
 /// Arguments of `shape`.
 #[derive(Debug, Args)]
@@ -90,7 +90,7 @@ struct PositionList(Vec<Position>);
 
 /// Builds the bank, saves it atomically and prints what it is. Nothing is written on failure.
 pub(super) fn run(args: &ShapeArgs) -> Result<(), String> {
-    check_output_dir(&args.output)?;
+    check_output("-o", &args.output, &[])?;
     let given = [
         (Dimension::Length, args.length),
         (Dimension::Width, args.width),
@@ -227,6 +227,24 @@ pub(super) fn parse_positive(text: &str) -> Result<f64, String> {
         .ok()
         .filter(|v| v.is_finite() && *v > 0.0)
         .ok_or_else(|| format!("expected a number above 0, found \"{text}\""))
+}
+
+/// Largest loss factor (`1/Q` of internal friction) an option takes: a Q of 2, far lossier than
+/// rubber (about 0.1), where a struck object no longer rings.
+pub(super) const MAX_LOSS_FACTOR: f64 = 0.5;
+
+/// Parses a loss factor: above 0, at most [`MAX_LOSS_FACTOR`].
+pub(super) fn parse_loss_factor(text: &str) -> Result<f64, String> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|v| *v > 0.0 && *v <= MAX_LOSS_FACTOR)
+        .ok_or_else(|| {
+            format!(
+                "expected a loss factor above 0 and at most {MAX_LOSS_FACTOR} (a Q of 2; metals \
+                 are about 1e-4, wood 8e-3, rubber 0.1), found \"{text}\""
+            )
+        })
 }
 
 /// Parses `--tuning`: a named tuning or comma-separated ratios.

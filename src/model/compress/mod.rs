@@ -31,6 +31,10 @@ use crate::dsp::coeffs::MIN_DECAY_PER_S;
 /// Default level below the strongest mode under which modes are dropped, in dB.
 pub const DEFAULT_DROP_BELOW_DB: f64 = -80.0;
 
+/// Largest limen scale: modes ten limens apart are heard as clearly apart, and merging them
+/// would change the sound, not only its cost.
+pub const MAX_LIMEN_SCALE: f64 = 10.0;
+
 /// What to compress and how far.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CompressOptions {
@@ -114,11 +118,11 @@ impl std::error::Error for CompressError {}
 impl CompressOptions {
     /// `Ok` when every option is in range.
     pub fn check(&self) -> Result<(), CompressError> {
-        if !(self.limen_scale.is_finite() && self.limen_scale >= 0.0) {
+        if !(0.0..=MAX_LIMEN_SCALE).contains(&self.limen_scale) {
             return Err(CompressError::BadOption {
                 name: "--limen-scale",
                 value: self.limen_scale,
-                expected: "a number 0 or above",
+                expected: "a number from 0 to 10 (1 merges what a listener cannot tell apart)",
             });
         }
         match self.drop_below_db {

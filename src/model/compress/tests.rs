@@ -190,6 +190,11 @@ fn bad_options_are_refused() {
             limen_scale: f64::NAN,
             drop_below_db: None,
         },
+        // Would merge a whole bank into one mode.
+        CompressOptions {
+            limen_scale: 1e9,
+            drop_below_db: None,
+        },
         CompressOptions {
             limen_scale: 1.0,
             drop_below_db: Some(6.0),
