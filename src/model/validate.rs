@@ -89,7 +89,8 @@ pub const FREQ_HZ: NumberRange = NumberRange {
 /// its root play a 1 Hz mode lower still. 1 MHz as for [`FREQ_HZ`].
 pub const MODE_FREQ_HZ: NumberRange = NumberRange::closed(1.0, 1e6, " Hz");
 
-/// Mode decay rate: 0 rings forever; 1e6 per second dies within a sample at any audio rate.
+/// Mode decay rate: the engine plays rates under its floor (0.01 per second, a T60 of 690 s) at
+/// the floor; 1e6 per second dies within a sample at any audio rate.
 pub const DECAY_PER_S: NumberRange = NumberRange::closed(0.0, 1e6, " per second");
 
 /// Mode gain at one position: 1e6 (+120 dB) leaves room for any normalisation.
