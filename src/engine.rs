@@ -20,6 +20,7 @@ mod controls;
 mod expression;
 mod midi;
 mod mix;
+mod pitch_level;
 mod position;
 mod prepared;
 mod pruning;

@@ -4,6 +4,7 @@
 use std::f64::consts::TAU;
 
 use super::controls::Controls;
+use super::pitch_level::PitchLevel;
 use super::position::{PositionMap, PositionWeights};
 use super::stereo::{balanced_pans, lane_weights, COLUMN_PAN};
 use crate::dsp::coeffs::{ModeCoeffs, MIN_DECAY_PER_S};
@@ -55,6 +56,8 @@ pub struct PreparedBank {
     pub reference_q: f64,
     /// Gain applied to the bank's gains so a default strike peaks at `TARGET_PEAK`.
     pub normalization: f32,
+    /// Gain of a strike under the root, so a default strike peaks at `TARGET_PEAK` there too.
+    pub pitch_level: PitchLevel,
     /// Pan of each accumulator column at full width: the default spread dealt so that a default
     /// strike sounds centred.
     pub column_pan: [f32; COLUMNS],
@@ -109,9 +112,10 @@ impl PreparedBank {
             root_key: hz_to_midi_key(bank.effective_root_hz()).round(),
             reference_q,
             normalization: 1.0,
+            pitch_level: PitchLevel::default(),
             column_pan: COLUMN_PAN,
         };
-        let (frames, mut ringing) = prepared.render_default_strike();
+        let (frames, mut ringing) = prepared.render_default_strike(None);
         let mut cov = [[0.0f64; COLUMNS]; COLUMNS];
         for frame in &frames {
             for (row, &x) in cov.iter_mut().zip(frame) {
@@ -122,6 +126,7 @@ impl PreparedBank {
         }
         prepared.column_pan = balanced_pans(&cov);
         let peak = prepared.default_peak(&frames, &mut ringing);
+        prepared.pitch_level = prepared.measure_pitch_level(peak);
         if peak > 0.0 && peak.is_finite() {
             prepared.normalization = TARGET_PEAK / peak;
             for g in &mut prepared.gains {
@@ -196,7 +201,9 @@ impl PreparedBank {
     /// modes that this would cost more than `BALANCE_MODE_SAMPLES`, but never less than
     /// the first 0.2 to 1 s (more for low modes, to let their beating build up); and the modes
     /// still ringing at its end.
-    fn render_default_strike(&self) -> (Vec<[f32; COLUMNS]>, Ringing) {
+    ///
+    /// `kind` replaces the bank's default exciter when given.
+    fn render_default_strike(&self, kind: Option<ExciterKind>) -> (Vec<[f32; COLUMNS]>, Ringing) {
         let controls = Controls::for_bank(&self.source);
         let n = self.num_modes();
         let mut bank = ResonatorBank::new(n);
@@ -219,11 +226,11 @@ impl PreparedBank {
         let contact = (controls.hardness_ms as f64 * 1e-3 * MEASURE_RATE_HZ).round() as u32;
         // A bank played by a contact is set to the level of a mallet strike, which a contact at
         // its defaults matches.
-        let kind = if controls.exciter.is_contact() {
+        let kind = kind.unwrap_or(if controls.exciter.is_contact() {
             ExciterKind::Mallet
         } else {
             controls.exciter
-        };
+        });
         exciter.strike(kind, 1.0, contact);
         // Long enough for the slowest beating of the lowest modes to build up.
         let lowest = self.freq_hz.first().copied().unwrap_or(100.0).max(1.0);
@@ -246,6 +253,27 @@ impl PreparedBank {
                 kernel,
                 spent,
             },
+        )
+    }
+
+    /// The gain of strikes under the root for a bank whose default strike is a mallet's (or a
+    /// contact's, levelled as a mallet's), `root_peak` the default strike's peak: an impulse's
+    /// peak is measured the same way, and [`PitchLevel`] goes between them.
+    fn measure_pitch_level(&self, root_peak: f32) -> PitchLevel {
+        let controls = Controls::for_bank(&self.source);
+        if !(controls.exciter == ExciterKind::Mallet || controls.exciter.is_contact()) {
+            return PitchLevel::default();
+        }
+        let (frames, mut ringing) = self.render_default_strike(Some(ExciterKind::Impulse));
+        let impulse_peak = self.default_peak(&frames, &mut ringing);
+        let w = self.positions.weights(controls.strike_x, controls.strike_y);
+        let gains: Vec<f32> = (0..self.num_modes()).map(|m| self.gain_at(m, &w)).collect();
+        PitchLevel::new(
+            &self.freq_hz,
+            &gains,
+            controls.hardness_ms as f64 * 1e-3,
+            root_peak,
+            impulse_peak,
         )
     }
 

@@ -455,6 +455,13 @@ impl Engine {
             .max(1.0) as u32;
         let threshold = db_to_gain(c.truncation_db);
         let kind = c.exciter;
+        // A pulse under the root is held to the root's level (see `PitchLevel`); a contact's
+        // force is its own.
+        let amplitude = if kind.is_contact() {
+            amplitude
+        } else {
+            amplitude * self.bank.pitch_level.at(self.voices[i].log_pitch)
+        };
         // With pruning, modes the strike restarts are judged before they are computed. Started
         // dormant, they take only the pulses their bank knows of: while a strike it does not know
         // still plays (a noise burst, or one struck with pruning off), they are computed.
