@@ -137,6 +137,17 @@ impl Analysis {
         2.0 * (self.noise_density(freq_hz) * sum_sq).sqrt() / sum
     }
 
+    /// The frequency and decay of each mode found.
+    pub fn shapes(&self) -> Vec<Shape> {
+        self.modes
+            .iter()
+            .map(|m| Shape {
+                freq_hz: m.freq_hz,
+                decay_per_s: m.decay_per_s,
+            })
+            .collect()
+    }
+
     /// Joint amplitudes of `shapes` in this recording.
     pub fn amplitudes(&self, shapes: &[Shape]) -> Vec<Complex64> {
         fit_amplitudes(&self.signal, self.sample_rate_hz, self.start, shapes)
@@ -450,14 +461,7 @@ fn decay_as_the_recording_shows(a: &mut Analysis) {
     }
     let t = tail_start as f64 / rate;
     // The resynthesis of the tail alone: each mode's complex amplitude carried to its start.
-    let shapes: Vec<Shape> = a
-        .modes
-        .iter()
-        .map(|m| Shape {
-            freq_hz: m.freq_hz,
-            decay_per_s: m.decay_per_s,
-        })
-        .collect();
+    let shapes = a.shapes();
     let carried: Vec<Complex64> = a
         .modes
         .iter()

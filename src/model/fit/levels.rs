@@ -21,7 +21,7 @@
 use realfft::num_complex::Complex64;
 
 use super::analyse::Analysis;
-use super::lsq::{add_modes, Shape};
+use super::lsq::add_modes;
 use super::stft::{hann, Spectrogram};
 use super::track::Track;
 use crate::dsp::coeffs::MIN_DECAY_PER_S;
@@ -203,14 +203,7 @@ pub fn match_levels(a: &mut Analysis, min_hz: f64, max_hz: f64) {
 
 /// The spectrogram of `a`'s modes resynthesised.
 fn synthesize(a: &Analysis, window_len: usize, hop: usize) -> Spectrogram {
-    let shapes: Vec<Shape> = a
-        .modes
-        .iter()
-        .map(|m| Shape {
-            freq_hz: m.freq_hz,
-            decay_per_s: m.decay_per_s,
-        })
-        .collect();
+    let shapes = a.shapes();
     let amplitudes: Vec<Complex64> = a.modes.iter().map(|m| m.amplitude).collect();
     let mut model = vec![0.0; a.signal.len()];
     add_modes(&mut model, a.sample_rate_hz, &shapes, &amplitudes);
