@@ -19,13 +19,7 @@
 
 use std::f64::consts::TAU;
 
-/// Highest mode frequency rendered, as a fraction of the sample rate: above it a mode aliases or
-/// its pole crowds Nyquist (DESIGN.md).
-pub const MAX_FREQ_RATIO: f64 = 0.45;
-
-/// Smallest decay rate used, in 1/s: an undamped mode (decay 0 in a bank) still dies, after about
-/// 690 seconds, so the recursion is strictly stable in `f32` and a voice is eventually freed.
-pub const MIN_DECAY_PER_S: f64 = 0.01;
+use crate::model::bank::MAX_FREQ_RATIO;
 
 /// The recursion coefficient `q = p - 1` of one mode.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -12,6 +12,15 @@ pub const FORMAT_NAME: &str = "modal-bank";
 /// The major format version this build reads and writes.
 pub const FORMAT_VERSION: u32 = 1;
 
+/// Highest mode frequency rendered, as a fraction of the sample rate: above it a mode aliases or
+/// its pole crowds Nyquist (DESIGN.md). A bank's modes above it at a rate are left out there.
+pub const MAX_FREQ_RATIO: f64 = 0.45;
+
+/// Smallest decay rate played, in 1/s: a mode whose bank gives less (0 included) decays at this
+/// rate, dying after about 690 seconds, so the recursion is strictly stable in `f32` and a
+/// voice is eventually freed.
+pub const MIN_DECAY_PER_S: f64 = 0.01;
+
 /// A modal bank: how one object rings when struck at each of its measured positions.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
@@ -183,10 +192,7 @@ impl Bank {
         let mut qs: Vec<f64> = self
             .modes
             .iter()
-            .map(|m| {
-                std::f64::consts::PI * m.freq_hz
-                    / m.decay_per_s.max(crate::dsp::coeffs::MIN_DECAY_PER_S)
-            })
+            .map(|m| std::f64::consts::PI * m.freq_hz / m.decay_per_s.max(MIN_DECAY_PER_S))
             .collect();
         if qs.is_empty() {
             return None;

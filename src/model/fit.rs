@@ -48,7 +48,7 @@ use self::analyse::{analyse, prepare, Analysis};
 use self::combine::{combine, Combined};
 use self::fidelity::fidelity;
 use self::lsq::Shape;
-use crate::dsp::coeffs::MAX_FREQ_RATIO;
+use crate::model::bank::MAX_FREQ_RATIO;
 use crate::model::bank::{Bank, Mode, Position};
 use crate::units::decay_to_t60_s;
 

@@ -26,7 +26,7 @@ use serde_json::json;
 use super::limen::difference_limen_hz;
 use super::validate::validate_bank;
 use super::{Bank, Mode, Problem};
-use crate::dsp::coeffs::MIN_DECAY_PER_S;
+use crate::model::bank::MIN_DECAY_PER_S;
 
 /// Default level below the strongest mode under which modes are dropped, in dB.
 pub const DEFAULT_DROP_BELOW_DB: f64 = -80.0;

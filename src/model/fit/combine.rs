@@ -12,7 +12,7 @@ use realfft::num_complex::Complex64;
 use super::analyse::{energy_over, Analysis, INAUDIBLE_DB};
 use super::lsq::Shape;
 use super::track::Track;
-use crate::dsp::coeffs::MIN_DECAY_PER_S;
+use crate::model::bank::MIN_DECAY_PER_S;
 use crate::model::limen::difference_limen_hz;
 
 /// A mode of the fitted bank.

@@ -16,7 +16,7 @@ use realfft::num_complex::Complex64;
 
 use super::analyse::Analysis;
 use super::stft::{hann, Spectrogram};
-use crate::dsp::coeffs::{MAX_FREQ_RATIO, MIN_DECAY_PER_S};
+use crate::model::bank::{MAX_FREQ_RATIO, MIN_DECAY_PER_S};
 use crate::model::Bank;
 
 /// Length of the comparison's frames in seconds (rounded to a power of two of samples): about

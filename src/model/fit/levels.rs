@@ -24,7 +24,7 @@ use super::analyse::Analysis;
 use super::lsq::add_modes;
 use super::stft::{hann, Spectrogram};
 use super::track::Track;
-use crate::dsp::coeffs::MIN_DECAY_PER_S;
+use crate::model::bank::MIN_DECAY_PER_S;
 
 /// Length of the frames compared, in seconds: short enough to follow a 20 ms decay, long enough
 /// to resolve partials 50 Hz apart.
