@@ -30,13 +30,13 @@ mod voice;
 use std::sync::Arc;
 
 pub use controls::{
-    control_range, ControlSpec, Controls, Material, ANALYSIS_FRAME_RANGE_MS,
+    control_range, ControlSpec, Controls, ExpressionTarget, Material, ANALYSIS_FRAME_RANGE_MS,
     CONTACT_SPEED_MAX_M_PER_S, HARDNESS_RANGE_MS, MASKING_OFFSET_RANGE_DB, MATERIAL_Q_RANGE,
     MAX_MODE_BUDGET, MAX_POLYPHONY, MAX_TARGET_LOAD_PCT, MPE_DEFAULT_BEND_RANGE_SEMITONES,
     NUMERIC_CONTROLS, PLAYBACK_LEVEL_RANGE_DB_SPL, VARIATION_CENTS, VARIATION_DECAY,
     VARIATION_GAIN_DB,
 };
-pub use expression::{ControlChange, Controllers, ExpressionTarget};
+pub use expression::{ControlChange, Controllers};
 pub use midi::{bend_of, MidiInput, MidiMessage, CHANNELS, MPE_MANAGER_CHANNEL, SLIDE_CC};
 pub use mix::{
     mix_to_mono, Bypass, DryWet, FadeOut, OnsetTrigger, BANK_CROSSFADE_S, BYPASS_FADE_S,

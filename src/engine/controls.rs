@@ -2,8 +2,10 @@
 //! one table shared by the plugin's parameters, the command line and the tests.
 
 mod by_name;
+mod target;
 
-use super::expression::ExpressionTarget;
+pub use target::ExpressionTarget;
+
 use super::position::PositionMap;
 use crate::dsp::ExciterKind;
 use crate::model::validate::{
