@@ -16,6 +16,7 @@
 //! positions) change the sound.
 
 mod analyse;
+mod analysis;
 mod bandfit;
 mod closed_form;
 mod combine;
@@ -44,7 +45,8 @@ pub use fidelity::{synthesize_strike, Fidelity};
 pub use report::{save_report_file, stage_report_file, FitReport, ModeReport, RecordingReport};
 pub use wav::read_wav_recording;
 
-use self::analyse::{analyse, prepare, Analysis};
+use self::analyse::{analyse, prepare};
+use self::analysis::Analysis;
 use self::combine::{combine, Combined};
 use self::fidelity::fidelity;
 use self::lsq::Shape;

@@ -9,7 +9,8 @@
 
 use realfft::num_complex::Complex64;
 
-use super::analyse::{energy_over, Analysis, INAUDIBLE_DB};
+use super::analyse::{energy_over, INAUDIBLE_DB};
+use super::analysis::Analysis;
 use super::lsq::Shape;
 use super::track::Track;
 use crate::model::bank::MIN_DECAY_PER_S;

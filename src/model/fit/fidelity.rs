@@ -14,7 +14,7 @@ use std::f64::consts::TAU;
 
 use realfft::num_complex::Complex64;
 
-use super::analyse::Analysis;
+use super::analysis::Analysis;
 use super::stft::{hann, Spectrogram};
 use crate::model::bank::{MAX_FREQ_RATIO, MIN_DECAY_PER_S};
 use crate::model::Bank;

@@ -20,7 +20,7 @@
 
 use realfft::num_complex::Complex64;
 
-use super::analyse::Analysis;
+use super::analysis::{Analysis, Found};
 use super::lsq::add_modes;
 use super::stft::{hann, Spectrogram};
 use super::track::Track;
@@ -279,7 +279,7 @@ fn add_missing(
             continue;
         }
         // A unit mode's power in the part sets the amplitude.
-        let unit = super::analyse::Found {
+        let unit = Found {
             freq_hz,
             decay_per_s,
             amplitude: Complex64::new(0.0, -1.0),
@@ -294,7 +294,7 @@ fn add_missing(
         // its onset.
         let first_frame_db = at_onset_db + slope_db_per_s * frame_s[0];
         let amplitude = (10f64.powf(first_frame_db / 10.0) / unit_power).sqrt();
-        added.push(super::analyse::Found {
+        added.push(Found {
             amplitude: Complex64::new(0.0, -amplitude),
             gain: amplitude,
             track: Track {
@@ -381,7 +381,7 @@ fn line(points: &[(f64, f64)]) -> Option<(f64, f64)> {
 }
 
 /// The pole of mode `m` at `rate`.
-fn pole(m: &super::analyse::Found, rate: f64) -> Complex64 {
+fn pole(m: &Found, rate: f64) -> Complex64 {
     Complex64::from_polar(
         (-m.decay_per_s / rate).exp(),
         std::f64::consts::TAU * m.freq_hz / rate,
@@ -392,7 +392,7 @@ fn pole(m: &super::analyse::Found, rate: f64) -> Complex64 {
 /// the mode `m`, `Re(c z^n) = (c z^n + c* z*^n) / 2`: of its two halves apart, so a later
 /// frame's, `n` shifted by `s`, is `z^s` times the first and `z*^s` times the second.
 fn own_spectrum(
-    m: &super::analyse::Found,
+    m: &Found,
     rate: f64,
     window: &[f64],
     bins: std::ops::Range<usize>,
@@ -427,7 +427,7 @@ fn own_spectrum(
 /// Power in bins `bins` of the `fft_len`-point transform of the first frame (windowed by
 /// `window`) of the mode `m`.
 fn own_power(
-    m: &super::analyse::Found,
+    m: &Found,
     rate: f64,
     window: &[f64],
     bins: std::ops::Range<usize>,
@@ -444,7 +444,8 @@ fn own_power(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::fit::analyse::{prepare, Found};
+    use crate::model::fit::analyse::prepare;
+    use crate::model::fit::analysis::Found;
     use crate::model::fit::{FitOptions, Recording};
 
     const RATE: u32 = 48_000;
