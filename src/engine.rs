@@ -29,6 +29,8 @@ mod voice;
 
 use std::sync::Arc;
 
+/// How a note excites the bank: the engine's controls name it, the layers above set it.
+pub use crate::dsp::ExciterKind;
 pub use controls::{
     control_range, ControlSpec, Controls, ExpressionTarget, Material, ANALYSIS_FRAME_RANGE_MS,
     CONTACT_SPEED_MAX_M_PER_S, HARDNESS_RANGE_MS, MASKING_OFFSET_RANGE_DB, MATERIAL_Q_RANGE,

@@ -18,10 +18,9 @@ pub use midi_file::{read_midi_file, TimedMidi};
 pub use notes::{parse_notes, Note};
 pub use wav::{to_int_sample, wav_bytes, write_wav, BitDepth, WavEncoder, WavFile};
 
-use crate::dsp::ExciterKind;
 use crate::engine::{
-    Controls, Engine, MidiInput, MidiMessage, NoteEvent, NoteExpression, PositionMap, PreparedBank,
-    CONTACT_SPEED_MAX_M_PER_S,
+    Controls, Engine, ExciterKind, MidiInput, MidiMessage, NoteEvent, NoteExpression, PositionMap,
+    PreparedBank, CONTACT_SPEED_MAX_M_PER_S,
 };
 use crate::model::Bank;
 use crate::units::{db_to_gain, gain_to_db};
