@@ -9,9 +9,10 @@ use std::sync::Arc;
 use clap::Args;
 
 use modal_resonator::engine::{Controls, PositionMap, PreparedBank};
+use modal_resonator::model::Bank;
 use modal_resonator::render::{
-    parse_notes, read_midi_file, render_to, wav_bytes, BitDepth, Note, RenderSettings, Rendered,
-    Score, TimedMidi, WavFile,
+    parse_notes, read_midi_file, render_to, wav_bytes, BitDepth, Note, RenderSettings,
+    RenderSummary, Rendered, Score, TimedMidi, WavFile,
 };
 
 use super::progress::Progress;
@@ -71,7 +72,37 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
     }
     check_output("-o", &args.output, &inputs)?;
     let bank = loaded.bank;
-    let mut controls = Controls::for_bank(&bank);
+    let controls = controls(args, &bank)?;
+    let (notes, midi) = read_score(args, &controls)?;
+    let score = if args.notes.is_some() {
+        Score::Notes(&notes)
+    } else {
+        Score::Midi(&midi)
+    };
+    if let Some((number, time_s)) = score.first_note_from(args.max_seconds) {
+        return Err(format!(
+            "note {number} starts at {time_s} s, at or after --max-seconds {}",
+            args.max_seconds
+        ));
+    }
+    let settings = RenderSettings {
+        sample_rate_hz: args.rate,
+        bit_depth: args.bits,
+        controls,
+        max_seconds: args.max_seconds,
+        ..RenderSettings::default()
+    };
+    let mut progress = Progress::new("rendering");
+    let bank = Arc::new(PreparedBank::new(&bank));
+    let rendered = render_output(args, &bank, score, &settings, &mut progress)?;
+    let elapsed = progress.finish();
+    Ok(report(args, &rendered, score, elapsed.as_secs_f64()))
+}
+
+/// The bank's controls with every `--set` on top; a setting along an axis the bank's positions
+/// do not span is warned of.
+fn controls(args: &RenderArgs, bank: &Bank) -> Result<Controls, String> {
+    let mut controls = Controls::for_bank(bank);
     for (name, value) in &args.set {
         controls
             .set_by_name(name, value)
@@ -93,7 +124,16 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
             );
         }
     }
-    let (notes, midi): (Vec<Note>, Vec<TimedMidi>) = match (&args.notes, &args.midi) {
+    Ok(controls)
+}
+
+/// The notes of `--notes` or the MIDI of `--midi`; contact curves on the notes of a struck bank
+/// are refused.
+fn read_score(
+    args: &RenderArgs,
+    controls: &Controls,
+) -> Result<(Vec<Note>, Vec<TimedMidi>), String> {
+    let (notes, midi) = match (&args.notes, &args.midi) {
         (Some(text), _) => (
             parse_notes(text).map_err(|e| format!("--notes: {e}"))?,
             Vec::new(),
@@ -115,41 +155,24 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
             ));
         }
     }
-    let score = if args.notes.is_some() {
-        Score::Notes(&notes)
-    } else {
-        Score::Midi(&midi)
-    };
-    if let Some((number, time_s)) = score.first_note_from(args.max_seconds) {
-        return Err(format!(
-            "note {number} starts at {time_s} s, at or after --max-seconds {}",
-            args.max_seconds
-        ));
-    }
-    let to_stdout = args.output.as_os_str() == STDOUT;
-    let settings = RenderSettings {
-        sample_rate_hz: args.rate,
-        bit_depth: args.bits,
-        controls,
-        max_seconds: args.max_seconds,
-        ..RenderSettings::default()
-    };
+    Ok((notes, midi))
+}
 
-    let mut progress = Progress::new("rendering");
-    let bank = Arc::new(PreparedBank::new(&bank));
-    // With --normalize, a first pass finds the peak; renders are reproducible, so the second,
-    // scaled, has the same samples.
+/// Renders `score` into the output: a file written as the samples are made (removed on any
+/// error), or a WAV built in memory for standard output, which cannot seek back to fill in the
+/// header. With `--normalize`, a first pass finds the peak; renders are reproducible, so the
+/// second, scaled, has the same samples.
+fn render_output(
+    args: &RenderArgs,
+    bank: &Arc<PreparedBank>,
+    score: Score,
+    settings: &RenderSettings,
+    progress: &mut Progress,
+) -> Result<RenderSummary, String> {
     let (scale, first_share) = match args.normalize {
         Some(peak_dbfs) => {
             let quiet = |_: &[f32], _: &[f32]| Ok::<(), Infallible>(());
-            let Ok(first) = render_to(
-                &bank,
-                score,
-                &settings,
-                1.0,
-                |d| progress.set(0.5 * d),
-                quiet,
-            );
+            let Ok(first) = render_to(bank, score, settings, 1.0, |d| progress.set(0.5 * d), quiet);
             let scale = if first.peak > 0.0 {
                 10f32.powf(peak_dbfs / 20.0) / first.peak
             } else {
@@ -160,61 +183,58 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
         None => (1.0, 0.0),
     };
     let share = |done: f64| first_share + (1.0 - first_share) * done;
-    let rendered = if to_stdout {
-        // A stream cannot seek back to fill in the header: the WAV is built in memory.
-        let (mut left, mut right) = (Vec::new(), Vec::new());
-        let collect = |l: &[f32], r: &[f32]| {
-            left.extend_from_slice(l);
-            right.extend_from_slice(r);
-            Ok::<(), Infallible>(())
-        };
-        let Ok(rendered) = render_to(
-            &bank,
-            score,
-            &settings,
-            scale,
-            |d| progress.set(share(d)),
-            collect,
-        );
-        let whole = Rendered {
-            left,
-            right,
-            sample_rate_hz: args.rate,
-            max_voices: rendered.max_voices,
-            cut_short: rendered.cut_short,
-        };
-        let bytes = wav_bytes(&whole, args.bits, args.rate)
-            .map_err(|e| format!("standard output: cannot write WAV: {e}"))?;
-        let mut out = std::io::stdout().lock();
-        out.write_all(&bytes)
-            .and_then(|()| out.flush())
-            .map_err(|e| format!("standard output: {e}"))?;
-        rendered
-    } else {
-        // The samples go to disk as they are made; on any error the file is dropped unfinished,
-        // which removes it.
+    if args.output.as_os_str() != STDOUT {
         let mut file =
             WavFile::create(&args.output, args.bits, args.rate).map_err(|e| e.to_string())?;
         let rendered = render_to(
-            &bank,
+            bank,
             score,
-            &settings,
+            settings,
             scale,
             |d| progress.set(share(d)),
             |l, r| file.write(l, r),
         )
         .map_err(|e| e.to_string())?;
         file.finish().map_err(|e| e.to_string())?;
-        rendered
+        return Ok(rendered);
+    }
+    let (mut left, mut right) = (Vec::new(), Vec::new());
+    let collect = |l: &[f32], r: &[f32]| {
+        left.extend_from_slice(l);
+        right.extend_from_slice(r);
+        Ok::<(), Infallible>(())
     };
-    let elapsed = progress.finish();
-    // Under half its least level, a sample is written as zero.
-    let silent = rendered.peak < 0.5 * args.bits.least_level();
+    let Ok(rendered) = render_to(
+        bank,
+        score,
+        settings,
+        scale,
+        |d| progress.set(share(d)),
+        collect,
+    );
+    let whole = Rendered {
+        left,
+        right,
+        sample_rate_hz: args.rate,
+        max_voices: rendered.max_voices,
+        cut_short: rendered.cut_short,
+    };
+    let bytes = wav_bytes(&whole, args.bits, args.rate)
+        .map_err(|e| format!("standard output: cannot write WAV: {e}"))?;
+    let mut out = std::io::stdout().lock();
+    out.write_all(&bytes)
+        .and_then(|()| out.flush())
+        .map_err(|e| format!("standard output: {e}"))?;
+    Ok(rendered)
+}
 
+/// Prints the summary (on standard error when the WAV went to standard output) and warns of
+/// peaks over full scale and of silence; the exit status says which.
+fn report(args: &RenderArgs, rendered: &RenderSummary, score: Score, elapsed_s: f64) -> ExitCode {
+    let to_stdout = args.output.as_os_str() == STDOUT;
     let peak_dbfs = rendered.peak_dbfs();
     let over = rendered.peak > 1.0;
     let clipped = args.bits != BitDepth::Float32 && over;
-    // With the WAV on standard output, the summary goes to standard error.
     let summary = format!(
         "{}: {:.2} s, {} Hz {}, peak {:.1} dBFS{}, up to {} voices, rendered in {:.2} s{}",
         if to_stdout {
@@ -228,7 +248,7 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
         peak_dbfs,
         if clipped { " (clipped)" } else { "" },
         rendered.max_voices,
-        elapsed.as_secs_f64(),
+        elapsed_s,
         if rendered.cut_short {
             ", cut at --max-seconds"
         } else {
@@ -249,22 +269,23 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
             if clips == 1 { " is" } else { "s are" },
             args.bits.name()
         );
-    }
-    if over && !clipped {
+    } else if over {
         eprintln!(
             "warning: the render peaks at {peak_dbfs:+.1} dBFS, over full scale: the float file \
              keeps the peaks, but a player or a conversion to integers will clip them. Render \
              again with --normalize -1 to bring the peak to -1 dBFS"
         );
     }
-    if silent && score.first_note_from(0.0).is_none() {
+    // Under half its least level, a sample is written as zero.
+    if rendered.peak >= 0.5 * args.bits.least_level() {
+        return ExitCode::SUCCESS;
+    }
+    if score.first_note_from(0.0).is_none() {
         eprintln!(
             "warning: the render is silent: there are no notes to play (a MIDI file with no \
              note-on, or only tempo and other meta events)"
         );
-        return Ok(ExitCode::from(SILENT_EXIT));
-    }
-    if silent {
+    } else {
         eprintln!(
             "warning: the render is silent: every sample rounds to zero in the {} file. The \
              notes may be too soft, the bank's gains zero, or its modes above the playable \
@@ -272,9 +293,8 @@ pub(super) fn run(args: &RenderArgs) -> Result<ExitCode, String> {
             args.bits.name(),
             args.rate
         );
-        return Ok(ExitCode::from(SILENT_EXIT));
     }
-    Ok(ExitCode::SUCCESS)
+    ExitCode::from(SILENT_EXIT)
 }
 
 /// Parses `--normalize`: a level in dBFS from -100 to 0.
