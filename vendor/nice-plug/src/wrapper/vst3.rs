@@ -36,7 +36,26 @@ pub trait Vst3Plugin: Plugin {
     /// [`VST3_CLASS_ID`][Self::VST3_CLASS_ID`] in the correct order for the current platform so
     /// projects and presets can be shared between platforms. This should not be overridden.
     const PLATFORM_VST3_CLASS_ID: [u8; 16] = swap_vst3_uid_byte_order(Self::VST3_CLASS_ID);
+
+    /// The MIDI controllers the plugin reads when [`Plugin::MIDI_INPUT`] is
+    /// [`MidiConfig::MidiCCs`][nice_plug_core::midi::MidiConfig::MidiCCs] or higher, in VST3's
+    /// numbering: CC 0 to 127, 128 for channel pressure, 129 for pitch bend. VST3 has no MIDI
+    /// controller events, so each of these gets a hidden parameter on every channel that hosts
+    /// map the controller onto. All 130 by default: 2,080 parameters, which hosts that list
+    /// hidden parameters have to wade through.
+    const VST3_MIDI_CONTROLLERS: &'static [u8] = &VST3_ALL_MIDI_CONTROLLERS;
 }
+
+/// Every MIDI controller in VST3's numbering: CC 0 to 127, channel pressure, pitch bend.
+pub const VST3_ALL_MIDI_CONTROLLERS: [u8; 130] = {
+    let mut all = [0; 130];
+    let mut i = 0;
+    while i < all.len() {
+        all[i] = i as u8;
+        i += 1;
+    }
+    all
+};
 
 #[cfg(not(target_os = "windows"))]
 const fn swap_vst3_uid_byte_order(uid: [u8; 16]) -> [u8; 16] {

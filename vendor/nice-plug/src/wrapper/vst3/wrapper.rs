@@ -42,7 +42,7 @@ use widestring::U16CStr;
 
 use super::inner::{ProcessEvent, WrapperInner};
 use super::note_expressions;
-use super::util::{VST3_MIDI_CCS, VST3_MIDI_NUM_PARAMS, VST3_MIDI_PARAMS_START, u16strlcpy};
+use super::util::{VST3_MIDI_CCS, VST3_MIDI_PARAMS_START, u16strlcpy};
 use super::util::{VST3_MIDI_CHANNELS, VST3_MIDI_PARAMS_END};
 use crate::util::permit_alloc;
 use crate::wrapper::state;
@@ -615,7 +615,8 @@ impl<P: Vst3Plugin> IEditControllerTrait for Wrapper<P> {
     unsafe fn getParameterCount(&self) -> int32 {
         // We need to add a whole bunch of parameters if the plugin accepts MIDI CCs
         if P::MIDI_INPUT >= MidiConfig::MidiCCs {
-            self.inner.param_hashes.len() as i32 + VST3_MIDI_NUM_PARAMS as i32
+            let num_midi_params = P::VST3_MIDI_CONTROLLERS.len() * VST3_MIDI_CHANNELS as usize;
+            (self.inner.param_hashes.len() + num_midi_params) as i32
         } else {
             self.inner.param_hashes.len() as i32
         }
@@ -624,7 +625,7 @@ impl<P: Vst3Plugin> IEditControllerTrait for Wrapper<P> {
     unsafe fn getParameterInfo(&self, param_index: int32, info: *mut ParameterInfo) -> tresult {
         check_null_ptr!(info);
 
-        if param_index < 0 || param_index > unsafe { self.getParameterCount() } {
+        if param_index < 0 || param_index >= unsafe { self.getParameterCount() } {
             return kInvalidArgument;
         }
 
@@ -636,18 +637,18 @@ impl<P: Vst3Plugin> IEditControllerTrait for Wrapper<P> {
         let num_actual_params = self.inner.param_hashes.len() as i32;
         if P::MIDI_INPUT >= MidiConfig::MidiCCs && param_index >= num_actual_params {
             let midi_param_relative_idx = (param_index - num_actual_params) as u32;
-            // This goes up to 130 for the 128 CCs followed by channel pressure and pitch bend
-            let midi_cc = midi_param_relative_idx % VST3_MIDI_CCS;
-            let midi_channel = midi_param_relative_idx / VST3_MIDI_CCS;
-            let name = match midi_cc {
-                // kAfterTouch
-                128 => format!("MIDI Ch. {} Channel Pressure", midi_channel + 1),
-                // kPitchBend
-                129 => format!("MIDI Ch. {} Pitch Bend", midi_channel + 1),
-                n => format!("MIDI Ch. {} CC {}", midi_channel + 1, n),
-            };
+            // Only the controllers the plugin reads are listed, each on every channel. Their IDs
+            // stay those of the full range of 130 per channel, whatever the list
+            let num_controllers = P::VST3_MIDI_CONTROLLERS.len() as u32;
+            let controller_idx = (midi_param_relative_idx % num_controllers) as usize;
+            let midi_cc = P::VST3_MIDI_CONTROLLERS[controller_idx] as u32;
+            let midi_channel = midi_param_relative_idx / num_controllers;
+            // Named as JUCE's VST3 wrapper names these proxies, "MIDI CC <channel>|<controller>"
+            // (channels from 0; 128 is channel pressure, 129 pitch bend): hosts built on JUCE,
+            // pedalboard for one, recognise the name and leave these parameters out of their lists
+            let name = format!("MIDI CC {midi_channel}|{midi_cc}");
 
-            info.id = VST3_MIDI_PARAMS_START + midi_param_relative_idx;
+            info.id = VST3_MIDI_PARAMS_START + midi_cc + midi_channel * VST3_MIDI_CCS;
             u16strlcpy(&mut info.title, &name);
             u16strlcpy(&mut info.shortTitle, &name);
             info.flags = ParameterFlags_::kIsReadOnly | (1 << 4); // kIsHidden
@@ -1676,6 +1677,7 @@ impl<P: Vst3Plugin> IMidiMappingTrait for Wrapper<P> {
             || bus_index != 0
             || !(0..VST3_MIDI_CHANNELS as i16).contains(&channel)
             || !(0..VST3_MIDI_CCS as i16).contains(&midi_cc_number)
+            || !P::VST3_MIDI_CONTROLLERS.contains(&(midi_cc_number as u8))
         {
             return kResultFalse;
         }
