@@ -170,7 +170,16 @@ pub(crate) struct WrapperInner<P: Vst3Plugin> {
     /// having to add a setter function to the parameter (or even worse, have it be completely
     /// untyped).
     pub param_ptr_to_hash: HashMap<ParamPtr, u32>,
+    /// The value the host gave the edit controller for each parameter while audio was being
+    /// processed, as `f32` bits, or [`NO_CONTROLLER_VALUE`]. The host sends the processor the same
+    /// change, which is applied in `process()`; the parameter is not touched before then, but the
+    /// controller reports this value, as a VST3 edit controller does (Steinberg's validator checks
+    /// this in its bypass persistence test).
+    pub controller_values: HashMap<u32, AtomicU32>,
 }
+
+/// A [`WrapperInner::controller_values`] entry with no value: not the bits of any finite `f32`.
+const NO_CONTROLLER_VALUE: u32 = u32::MAX;
 
 /// Tasks that can be sent from the plugin to be executed on the main thread in a non-blocking
 /// realtime-safe way (either a random thread or `IRunLoop` on Linux, the OS' message loop on
@@ -317,6 +326,10 @@ impl<P: Vst3Plugin> WrapperInner<P> {
             .iter()
             .map(|(id, hash, _, _)| (id.clone(), *hash))
             .collect();
+        let controller_values = param_id_hashes_ptrs_groups
+            .iter()
+            .map(|(_, hash, _, _)| (*hash, AtomicU32::new(NO_CONTROLLER_VALUE)))
+            .collect();
         let param_ptr_to_hash = param_id_hashes_ptrs_groups
             .into_iter()
             .map(|(_, hash, ptr, _)| (ptr, hash))
@@ -380,6 +393,7 @@ impl<P: Vst3Plugin> WrapperInner<P> {
             param_units,
             param_id_to_hash,
             param_ptr_to_hash,
+            controller_values,
         });
 
         // FIXME: Right now this is safe, but if we are going to have a singleton main thread queue
@@ -529,6 +543,29 @@ impl<P: Vst3Plugin> WrapperInner<P> {
             .get(&param)
             .and_then(|hash| self.param_id_by_hash.get(hash))
             .map(|s| s.as_str())
+    }
+
+    /// Sets the value the edit controller reports for parameter `hash` until the processor
+    /// applies a change to it (`None` forgets it). Never allocates: the audio thread calls this.
+    pub fn set_controller_value(&self, hash: u32, normalized_value: Option<f32>) {
+        if let Some(value) = self.controller_values.get(&hash) {
+            let bits = normalized_value.map_or(NO_CONTROLLER_VALUE, f32::to_bits);
+            value.store(bits, Ordering::Release);
+        }
+    }
+
+    /// The value the edit controller reports for parameter `hash` while the processor has yet to
+    /// apply it, if any.
+    pub fn controller_value(&self, hash: u32) -> Option<f32> {
+        let bits = self.controller_values.get(&hash)?.load(Ordering::Acquire);
+        (bits != NO_CONTROLLER_VALUE).then(|| f32::from_bits(bits))
+    }
+
+    /// Forgets every value given to the edit controller: the parameters hold the truth again.
+    pub fn clear_controller_values(&self) {
+        for value in self.controller_values.values() {
+            value.store(NO_CONTROLLER_VALUE, Ordering::Release);
+        }
     }
 
     /// Convenience function for setting a value for a parameter as triggered by a VST3 parameter

@@ -548,6 +548,8 @@ impl<P: Vst3Plugin> IComponentTrait for Wrapper<P> {
             Some(mut state) => {
                 if self.inner.set_state_inner(&mut state) {
                     crate::nice_trace!("Loaded state ({} bytes)", read_buffer.len());
+                    // The state's values replace any the controller was given
+                    self.inner.clear_controller_values();
                     kResultOk
                 } else {
                     kResultFalse
@@ -761,6 +763,9 @@ impl<P: Vst3Plugin> IEditControllerTrait for Wrapper<P> {
     }
 
     unsafe fn getParamNormalized(&self, id: ParamID) -> ParamValue {
+        if let Some(value) = self.inner.controller_value(id) {
+            return value as f64;
+        }
         match self.inner.param_by_hash.get(&id) {
             Some(param_ptr) => unsafe { param_ptr.modulated_normalized_value() as f64 },
             _ => 0.5,
@@ -769,10 +774,14 @@ impl<P: Vst3Plugin> IEditControllerTrait for Wrapper<P> {
 
     unsafe fn setParamNormalized(&self, id: ParamID, value: ParamValue) -> tresult {
         // If the plugin is currently processing audio, then this parameter change will also be sent
-        // to the process function
+        // to the process function. Until then the controller shows the value it was given.
         if self.inner.is_processing.load(Ordering::SeqCst) {
+            if value.is_finite() {
+                self.inner.set_controller_value(id, Some(value as f32));
+            }
             return kResultOk;
         }
+        self.inner.set_controller_value(id, None);
 
         let sample_rate = self
             .inner
@@ -1028,6 +1037,9 @@ impl<P: Vst3Plugin> IAudioProcessorTrait for Wrapper<P> {
         // Always reset the processing status when the plugin gets activated or deactivated
         self.inner.last_process_status.store(ProcessStatus::Normal);
         self.inner.is_processing.store(state, Ordering::SeqCst);
+        // A value given to the controller while processing that never reached the processor is
+        // not what plays: the controller shows the parameters again.
+        self.inner.clear_controller_values();
 
         // This function is also used to reset buffers on the plugin, so we should do the same
         // thing. We don't call `reset()` in `setup_processing()` for that same reason.
@@ -1170,6 +1182,9 @@ impl<P: Vst3Plugin> IAudioProcessorTrait for Wrapper<P> {
                                     total_buffer_len as u32,
                                 );
                                 let value = value as f32;
+                                // The processor has this parameter's value now: the controller
+                                // shows it again
+                                self.inner.set_controller_value(param_hash, None);
 
                                 // MIDI CC messages, channel pressure, and pitch bend are also sent
                                 // as parameter changes
