@@ -49,6 +49,8 @@ pub struct EditorLayout {
     pub mode_view: Rect,
     /// The strike pad's area (positions 0 to 1 on each axis, y up).
     pub strike_area: Rect,
+    /// The whole strike pad, the positions' names included.
+    pub strike_pad: Rect,
 }
 
 /// What the widgets need of the plugin for one frame.
@@ -205,7 +207,13 @@ impl EditorApp {
         EditorLayout {
             mode_view: self.view.plot_rect(),
             strike_area: self.pad.area(),
+            strike_pad: self.pad.rect(),
         }
+    }
+
+    /// The positions' names the strike pad wrote in the last frame, with where.
+    pub fn strike_pad_labels(&self) -> &[(String, Rect)] {
+        self.pad.labels()
     }
 
     /// The meters' last reading.
