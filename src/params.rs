@@ -414,11 +414,29 @@ fn linear((min, max): (f32, f32)) -> FloatRange {
     FloatRange::Linear { min, max }
 }
 
+/// Steps of a numeric parameter, with its text rounded to the step.
+trait RoundedSteps {
+    /// `self` moving in steps of `step_size`, its text rounded to the step's decimals and never
+    /// negative zero: a value just under zero would print "-0.0 dB", which reads back as 0 and
+    /// prints "0.0 dB", so the host's text would not read back as itself (clap-validator's
+    /// conversion test).
+    fn with_rounded_steps(self, step_size: f32) -> Self;
+}
+
+impl RoundedSteps for FloatParam {
+    fn with_rounded_steps(self, step_size: f32) -> Self {
+        // 1 gives 0 decimals, 0.1 one, 0.01 two.
+        let decimals = (-step_size.log10()).ceil().max(0.0) as usize;
+        self.with_step_size(step_size)
+            .with_value_to_string(formatters::v2s_f32_rounded(decimals))
+    }
+}
+
 /// A level in dB over `range`, in steps of 0.1 dB.
 fn decibels(name: &str, default: f32, range: (f32, f32)) -> FloatParam {
     FloatParam::new(name, default, linear(range))
         .with_unit(" dB")
-        .with_step_size(0.1)
+        .with_rounded_steps(0.1)
 }
 
 impl ModalParams {
@@ -444,7 +462,7 @@ impl ModalParams {
                     },
                 )
                 .with_unit(" x")
-                .with_step_size(0.001)
+                .with_rounded_steps(0.001)
                 .with_smoother(SmoothingStyle::None)
                 .with_poly_modulation_id(poly_id::SIZE),
                 key_tracking: percent("Key tracking", d.key_tracking),
@@ -454,7 +472,7 @@ impl ModalParams {
                     linear(control_range("fine_tune_cents")),
                 )
                 .with_unit(" ct")
-                .with_step_size(0.1)
+                .with_rounded_steps(0.1)
                 .with_poly_modulation_id(poly_id::FINE_TUNE),
                 bend_range: FloatParam::new(
                     "Pitch bend range",
@@ -465,7 +483,7 @@ impl ModalParams {
                     },
                 )
                 .with_unit(" st")
-                .with_step_size(1.0),
+                .with_rounded_steps(1.0),
             },
             strike: StrikeParams {
                 strike_x: percent("Strike position", d.strike_x)
@@ -477,7 +495,7 @@ impl ModalParams {
                 exciter: EnumParam::new("Exciter", ExciterChoice::of(d.exciter)),
                 hardness: skewed("Hardness", d.hardness_ms, "hardness_ms", -2.5)
                     .with_unit(" ms")
-                    .with_step_size(0.01)
+                    .with_rounded_steps(0.01)
                     .with_poly_modulation_id(poly_id::HARDNESS),
                 velocity_sensitivity: percent("Velocity sensitivity", 0.8),
                 velocity_to_hardness: percent("Velocity to hardness", 0.5),
@@ -489,7 +507,7 @@ impl ModalParams {
                     -1.5,
                 )
                 .with_unit(" mm")
-                .with_step_size(0.1),
+                .with_rounded_steps(0.1),
                 contact_speed: skewed(
                     "Contact speed",
                     d.contact_speed_m_per_s,
@@ -497,7 +515,7 @@ impl ModalParams {
                     -1.0,
                 )
                 .with_unit(" m/s")
-                .with_step_size(0.01)
+                .with_rounded_steps(0.01)
                 .with_poly_modulation_id(poly_id::CONTACT_SPEED),
                 contact_force: percent("Contact force", d.contact_force)
                     .with_poly_modulation_id(poly_id::CONTACT_FORCE),
@@ -513,13 +531,13 @@ impl ModalParams {
                         factor: FloatRange::skew_factor(-2.0),
                     },
                 )
-                .with_step_size(1.0),
+                .with_rounded_steps(1.0),
                 damping_tilt: FloatParam::new(
                     "Damping tilt",
                     d.damping_tilt,
                     linear(control_range("damping_tilt")),
                 )
-                .with_step_size(0.01),
+                .with_rounded_steps(0.01),
                 release_damping: percent("Release damping", 0.0),
             },
             voices: VoiceParams {
@@ -548,7 +566,7 @@ impl ModalParams {
                     },
                 )
                 .with_unit(" st")
-                .with_step_size(1.0),
+                .with_rounded_steps(1.0),
             },
             output: OutputParams {
                 output_gain: decibels("Output gain", 0.0, control_range("output_gain_db")),
@@ -579,7 +597,7 @@ impl ModalParams {
                     },
                 )
                 .with_unit(" ms")
-                .with_step_size(1.0),
+                .with_rounded_steps(1.0),
             },
             bypass: BoolParam::new("Bypass", false).make_bypass(),
             pruning: PruningParams::new(&d),
@@ -716,6 +734,47 @@ mod tests {
                 p.object.bend_range.preview_plain(1.0),
                 control_range("pitch_bend_semitones").1
             );
+        }
+    }
+
+    /// Normalised values to try on `param`: a fine grid over its range, and plain values just
+    /// either side of zero, where a number rounded for display can print as "-0.0".
+    fn values_to_try(param: &ParamPtr) -> Vec<f32> {
+        const GRID: u16 = 1000;
+        let grid = (0..=GRID).map(|i| f32::from(i) / f32::from(GRID));
+        let near_zero = [
+            -0.5, -0.049, -0.04, -0.004, -1e-6, 0.0, 1e-6, 0.004, 0.04, 0.049, 0.5,
+        ];
+        // SAFETY: the parameter lives as long as the test's `ModalParams`.
+        let near_zero = near_zero.map(|plain| unsafe { param.preview_normalized(plain) });
+        grid.chain(near_zero).collect()
+    }
+
+    /// Every parameter's text reads back as the same text, with and without its unit:
+    /// clap-validator's conversion test (value to text, to value, to text again) at many
+    /// values, so a host showing a value and a player typing it back agree.
+    #[test]
+    fn every_parameters_text_reads_back_as_itself() {
+        for is_effect in [false, true] {
+            let p = ModalParams::new(is_effect);
+            for (id, param, _) in p.param_map() {
+                for normalized in values_to_try(&param) {
+                    for unit in [true, false] {
+                        // SAFETY: as above.
+                        let (text, back, again) = unsafe {
+                            let text = param.normalized_value_to_string(normalized, unit);
+                            let back = param.string_to_normalized_value(&text);
+                            let again = back.map(|b| param.normalized_value_to_string(b, unit));
+                            (text, back, again)
+                        };
+                        assert_eq!(
+                            again.as_deref(),
+                            Some(text.as_str()),
+                            "{id} at {normalized}: {text:?} reads back as {back:?}"
+                        );
+                    }
+                }
+            }
         }
     }
 }

@@ -21,6 +21,9 @@ use modal_resonator::model::io::bank_to_json;
 use modal_resonator::model::{load_bank_file, Bank};
 use nice_plug::prelude::{Param, Params};
 
+/// Most space between two widgets stacked in a panel, in points.
+const ROW_GAP: f32 = 12.0;
+
 #[test]
 fn every_factory_bank_draws_at_every_size_and_scale() {
     let sizes = [
@@ -74,6 +77,103 @@ fn every_factory_bank_draws_at_every_size_and_scale() {
             }
         }
     }
+}
+
+/// Window sizes from the smallest to a large screen, in points: the strike pad and the bank
+/// list change with both width and height.
+const SIZES: [(f32, f32); 7] = [
+    EDITOR_MIN_SIZE,
+    (1000.0, 600.0),
+    (900.0, 800.0),
+    (EDITOR_SIZE.0 as f32, EDITOR_SIZE.1 as f32),
+    (1400.0, 900.0),
+    (1920.0, 1080.0),
+    (2560.0, 1600.0),
+];
+
+/// The strike pad writes the name of every position of every factory bank at every window size,
+/// inside the pad, clear of the positions' marks, and never over another name (on the marimba
+/// bar, "quarter" and "near centre" once printed as "quartemear centre").
+#[test]
+fn the_strike_pads_names_never_overlap() {
+    for bank in factory_banks() {
+        let mut h = Harness::new(Some(&bank));
+        for (width, height) in SIZES {
+            h.size = vec2(width, height);
+            h.settle();
+            let context = format!("{} at {width} x {height}", bank.name);
+            let labels = h.app.strike_pad_labels().to_vec();
+            let mut drawn: Vec<&str> = labels.iter().map(|(name, _)| name.as_str()).collect();
+            let mut names: Vec<&str> = bank.positions.iter().map(|p| p.name.as_str()).collect();
+            drawn.sort_unstable();
+            names.sort_unstable();
+            assert_eq!(drawn, names, "{context}: the names written");
+            let area = h.app.layout().strike_area;
+            let positions = h.app.session().positions();
+            let marks: Vec<Pos2> = positions
+                .coords()
+                .iter()
+                .map(|c| match positions.dims() {
+                    2 => at(area, c[0] as f32, c[1] as f32),
+                    _ => pos2(at(area, c[0] as f32, 0.0).x, area.center().y),
+                })
+                .collect();
+            let pad = h.app.layout().strike_pad;
+            for (i, (name, rect)) in labels.iter().enumerate() {
+                assert!(
+                    pad.contains_rect(*rect),
+                    "{context}: {name:?} at {rect:?} leaves the pad {pad:?}"
+                );
+                for mark in &marks {
+                    assert!(!rect.contains(*mark), "{context}: {name:?} covers a mark");
+                }
+                for (other, other_rect) in &labels[i + 1..] {
+                    assert!(
+                        !rect.intersects(*other_rect),
+                        "{context}: {name:?} at {rect:?} runs into {other:?} at {other_rect:?}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// The list of factory banks takes the height the bank panel leaves it, down to the user banks
+/// below it: a taller window shows more banks, and a tall one shows them all.
+#[test]
+fn the_factory_bank_list_fills_its_panel() {
+    let banks = factory_banks().len();
+    let mut h = Harness::new(None);
+    let mut shown_before = 0;
+    let mut sizes = SIZES;
+    sizes.sort_by(|a, b| a.1.total_cmp(&b.1));
+    for (width, height) in sizes {
+        h.size = vec2(width, height);
+        h.settle();
+        let context = format!("at {width} x {height}");
+        let layout = h.app.layout();
+        let shown = h.app.factory_banks_shown();
+        let gap = layout.bank_files.top() - layout.bank_list.bottom();
+        assert!(
+            (0.0..=ROW_GAP).contains(&gap) || shown == banks,
+            "{context}: the list {:?} ends {gap} points above the user banks {:?}",
+            layout.bank_list,
+            layout.bank_files
+        );
+        assert!(shown >= shown_before, "{context}: {shown} banks shown");
+        shown_before = shown;
+    }
+    h.size = vec2(EDITOR_SIZE.0 as f32, EDITOR_SIZE.1 as f32);
+    h.settle();
+    let shown = h.app.factory_banks_shown();
+    assert!(
+        shown >= 12,
+        "the window as it opens shows {shown} factory banks"
+    );
+    h.size = vec2(1920.0, 2400.0);
+    h.settle();
+    let shown = h.app.factory_banks_shown();
+    assert_eq!(shown, banks, "a tall window shows every factory bank");
 }
 
 #[test]

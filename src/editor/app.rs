@@ -12,7 +12,7 @@ use nice_plug::prelude::ParamSetter;
 use nice_plug_egui::baseview::HandlerError;
 use nice_plug_egui::{Frame, NiceEguiApp};
 
-use super::bank_browser::BankBrowser;
+use super::bank_browser::{BankBrowser, Loaded};
 use super::meters::Meters;
 use super::mode_view::{ModeView, ViewInput};
 use super::session::BankSession;
@@ -41,6 +41,13 @@ const SIDE_PANEL_WIDTH: (f32, f32) = (220.0, 320.0);
 const SIDE_PANEL_MAX_SHARE: f32 = 0.28;
 /// Share of the central area's width the strike pad takes, beside the mode editor.
 const STRIKE_PAD_SHARE: f32 = 0.6;
+/// Share of the bank panel's height the bank's facts start with, below the browser.
+const BANK_FACTS_SHARE: f32 = 0.3;
+/// Least height of the bank's facts, in points.
+const BANK_FACTS_MIN_HEIGHT: f32 = 80.0;
+/// Largest share of the bank panel's height the bank's facts can be resized to: the browser
+/// keeps the rest.
+const BANK_FACTS_MAX_SHARE: f32 = 0.8;
 
 /// Where the widgets were drawn, in points.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -49,6 +56,12 @@ pub struct EditorLayout {
     pub mode_view: Rect,
     /// The strike pad's area (positions 0 to 1 on each axis, y up).
     pub strike_area: Rect,
+    /// The whole strike pad, the positions' names included.
+    pub strike_pad: Rect,
+    /// The visible part of the list of factory banks.
+    pub bank_list: Rect,
+    /// The user banks, loading and saving, below the list of factory banks.
+    pub bank_files: Rect,
 }
 
 /// What the widgets need of the plugin for one frame.
@@ -202,10 +215,24 @@ impl EditorApp {
 
     /// Where the last frame put the widgets.
     pub fn layout(&self) -> EditorLayout {
+        let (bank_list, bank_files) = self.browser.rects();
         EditorLayout {
             mode_view: self.view.plot_rect(),
             strike_area: self.pad.area(),
+            strike_pad: self.pad.rect(),
+            bank_list,
+            bank_files,
         }
+    }
+
+    /// How many factory banks the browser's list showed whole in the last frame.
+    pub fn factory_banks_shown(&self) -> usize {
+        self.browser.factory_shown()
+    }
+
+    /// The positions' names the strike pad wrote in the last frame, with where.
+    pub fn strike_pad_labels(&self) -> &[(String, Rect)] {
+        self.pad.labels()
     }
 
     /// The meters' last reading.
@@ -282,18 +309,12 @@ impl EditorApp {
                     params_panel::show(ui, &params, setter, side_width, fixed_axes)
                 });
             });
-        let mut loaded = None;
-        Panel::right("bank")
+        let loaded = Panel::right("bank")
             .resizable(true)
             .default_size(side_width)
             .size_range(side_range.clone())
-            .show(ui, |ui| {
-                ScrollArea::vertical().id_salt("bank").show(ui, |ui| {
-                    loaded = self.browser.show(ui, &self.session);
-                    ui.separator();
-                    self.bank_facts(ui);
-                });
-            });
+            .show(ui, |ui| self.bank_panel(ui))
+            .inner;
         CentralPanel::default().show(ui, |ui| self.central(ui, &host));
         if let Some(loaded) = loaded {
             self.install(loaded, setter);
@@ -335,6 +356,25 @@ impl EditorApp {
                 }
             });
         });
+    }
+
+    /// The bank panel: the bank's facts below, in a share of the height the player can change;
+    /// the browser above, its list of factory banks taking the rest. Returns a bank the player
+    /// chose in the browser.
+    fn bank_panel(&mut self, ui: &mut Ui) -> Option<Loaded> {
+        let height = ui.available_height();
+        Panel::bottom("bank facts")
+            .frame(egui::Frame::NONE)
+            .resizable(true)
+            .default_size(height * BANK_FACTS_SHARE)
+            .size_range(BANK_FACTS_MIN_HEIGHT..=height * BANK_FACTS_MAX_SHARE)
+            .show(ui, |ui| {
+                ui.add_space(ui.spacing().item_spacing.y);
+                ScrollArea::vertical()
+                    .id_salt("bank facts")
+                    .show(ui, |ui| self.bank_facts(ui));
+            });
+        self.browser.show(ui, &self.session)
     }
 
     /// Problems with the bank, then what the bank is.

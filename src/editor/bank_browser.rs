@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use egui::{vec2, Align, Layout, RichText, ScrollArea, TextEdit, Ui};
+use egui::{vec2, Align, Frame, Layout, Panel, Rect, RichText, ScrollArea, TextEdit, Ui};
 use nice_plug::prelude::ParamSetter;
 
 use super::session::BankSession;
@@ -17,8 +17,8 @@ use crate::params::{ExciterChoice, MaterialChoice, ModalParams};
 
 /// How often the user folder is listed again while the browser shows.
 const RESCAN_INTERVAL: Duration = Duration::from_secs(2);
-/// Height of the file lists, in points.
-const LIST_HEIGHT: f32 = 130.0;
+/// Most height the list of user banks takes, in points (the factory banks take the rest).
+const USER_LIST_HEIGHT: f32 = 130.0;
 
 /// A bank read and checked, ready to play.
 #[derive(Debug, Clone)]
@@ -57,6 +57,12 @@ pub struct BankBrowser {
     save_name: String,
     /// The last outcome: text and whether it is an error.
     message: Option<(String, bool)>,
+    /// Where the factory list showed in the last frame.
+    factory_rect: Rect,
+    /// How many factory banks the list showed whole in the last frame.
+    factory_shown: usize,
+    /// Where the user banks, loading and saving showed in the last frame.
+    files_rect: Rect,
 }
 
 impl BankBrowser {
@@ -70,6 +76,9 @@ impl BankBrowser {
             path_text: String::new(),
             save_name: String::new(),
             message: None,
+            factory_rect: Rect::NOTHING,
+            factory_shown: 0,
+            files_rect: Rect::NOTHING,
         }
     }
 
@@ -87,6 +96,17 @@ impl BankBrowser {
     /// The last outcome shown: text and whether it is an error.
     pub fn message(&self) -> Option<(&str, bool)> {
         self.message.as_ref().map(|(m, e)| (m.as_str(), *e))
+    }
+
+    /// Where the factory list and, below it, the user banks with loading and saving showed in
+    /// the last frame.
+    pub fn rects(&self) -> (Rect, Rect) {
+        (self.factory_rect, self.files_rect)
+    }
+
+    /// How many factory banks the list showed whole in the last frame.
+    pub fn factory_shown(&self) -> usize {
+        self.factory_shown
     }
 
     /// Reads and checks the bank file at `path`; on failure shows why and returns `None`.
@@ -166,9 +186,25 @@ impl BankBrowser {
         }
     }
 
-    /// Draws the browser; returns a bank the player chose, read and checked.
+    /// Draws the browser in the height `ui` has: the user banks, loading and saving at the
+    /// bottom, and above them the factory banks, listed in all the height left. Returns a bank
+    /// the player chose, read and checked.
     pub fn show(&mut self, ui: &mut Ui, session: &BankSession) -> Option<Loaded> {
-        let mut chosen = None;
+        let files = Panel::bottom("bank files")
+            .frame(Frame::NONE)
+            .show_separator_line(false)
+            .show(ui, |ui| self.show_files(ui, session));
+        self.files_rect = files.response.rect;
+        let factory = self.show_factory(ui, session);
+        let chosen = factory.and_then(|slug| self.load_factory(&slug));
+        files
+            .inner
+            .and_then(|path| self.load_file(&path))
+            .or(chosen)
+    }
+
+    /// The factory banks, in all the height `ui` has left; returns the slug of one clicked.
+    fn show_factory(&mut self, ui: &mut Ui, session: &BankSession) -> Option<String> {
         let factory = self.factory.get_or_insert_with(|| {
             factory_banks()
                 .iter()
@@ -180,29 +216,36 @@ impl BankBrowser {
                 .collect()
         });
         ui.label(RichText::new("Factory banks").strong());
-        let mut factory_choice = None;
-        ScrollArea::vertical()
+        let mut choice = None;
+        let list = ScrollArea::vertical()
             .id_salt("factory banks")
-            .max_height(LIST_HEIGHT)
+            .max_height(ui.available_height())
+            .auto_shrink([false, true])
             .show(ui, |ui| {
                 for entry in factory.iter() {
                     let current = session.bank().name == entry.name;
                     let label = format!("{}  ·  {} modes", entry.name, entry.num_modes);
                     if ui.selectable_label(current, label).clicked() {
-                        factory_choice = Some(entry.slug.clone());
+                        choice = Some(entry.slug.clone());
                     }
                 }
             });
-        if let Some(slug) = factory_choice {
-            chosen = self.load_factory(&slug);
-        }
+        let row_pitch = list.content_size.y / factory.len().max(1) as f32;
+        let rows = (list.inner_rect.height() / row_pitch.max(1.0)).floor() as usize;
+        self.factory_shown = rows.min(factory.len());
+        self.factory_rect = list.inner_rect;
+        choice
+    }
 
+    /// The user banks, a file to load and saving the bank being edited; returns a file chosen.
+    fn show_files(&mut self, ui: &mut Ui, session: &BankSession) -> Option<PathBuf> {
         if self
             .scanned_at
             .is_none_or(|t| t.elapsed() > RESCAN_INTERVAL)
         {
             self.rescan();
         }
+        ui.add_space(ui.spacing().item_spacing.y);
         ui.label(RichText::new("User banks").strong());
         match &self.user_dir {
             Some(dir) => {
@@ -215,7 +258,7 @@ impl BankBrowser {
         let mut file_choice = None;
         ScrollArea::vertical()
             .id_salt("user banks")
-            .max_height(LIST_HEIGHT)
+            .max_height(USER_LIST_HEIGHT)
             .show(ui, |ui| {
                 if self.user_files.is_empty() {
                     ui.label(RichText::new("none yet: save one below").weak());
@@ -230,7 +273,13 @@ impl BankBrowser {
                     }
                 }
             });
+        self.show_load_and_save(ui, session).or(file_choice)
+    }
 
+    /// A path to load and a name to save the bank being edited under, and the last outcome;
+    /// returns the path when the player asks to load it.
+    fn show_load_and_save(&mut self, ui: &mut Ui, session: &BankSession) -> Option<PathBuf> {
+        let mut file_choice = None;
         ui.label(RichText::new("Load a file").strong());
         // Right to left, so the text field takes exactly the width the button leaves.
         let row = vec2(ui.available_width(), ui.spacing().interact_size.y);
@@ -245,9 +294,6 @@ impl BankBrowser {
                 file_choice = Some(PathBuf::from(self.path_text.trim()));
             }
         });
-        if let Some(path) = file_choice {
-            chosen = self.load_file(&path).or(chosen);
-        }
 
         ui.label(RichText::new("Save as").strong());
         if self.save_name.is_empty() {
@@ -271,7 +317,7 @@ impl BankBrowser {
             let colour = if *is_error { style::ERROR } else { style::OK };
             ui.label(RichText::new(text).color(colour));
         }
-        chosen
+        file_choice
     }
 }
 

@@ -3,7 +3,10 @@
 //! and the strike point. Pressing strikes the object there (auditions without MIDI) and holds the note
 //! until released; dragging moves the strike position parameters.
 
-use egui::{pos2, vec2, Align2, CornerRadius, FontId, Pos2, Rect, Sense, Slider, Stroke, Ui, Vec2};
+mod labels;
+
+use egui::{pos2, vec2, Color32, CornerRadius, FontId, Painter, Pos2, Rect, Response, Sense};
+use egui::{Slider, Stroke, Ui, Vec2};
 use nice_plug::prelude::ParamSetter;
 
 use super::app::Host;
@@ -14,10 +17,12 @@ use crate::params::ModalParams;
 
 /// Velocity of pad strikes until the player sets another.
 const DEFAULT_VELOCITY: f32 = 0.8;
-/// Height of the 1-D pad, in points.
-const LINE_HEIGHT: f32 = 64.0;
 /// Room around the pad's drawing area, in points.
 const INSET: f32 = 12.0;
+/// Size of the positions' names, in points.
+const NAME_SIZE: f32 = 10.0;
+/// How near a position's mark the pointer must be for the pad to name it, in points.
+const HOVER_RADIUS: f32 = 8.0;
 
 /// The pad's own state.
 #[derive(Debug, Clone)]
@@ -26,8 +31,12 @@ pub struct StrikePad {
     pub velocity: f32,
     /// Whether a pad strike is held (the pointer is down on the pad).
     held: bool,
+    /// The whole pad in the last frame.
+    rect: Rect,
     /// The area positions map to (0 to 1 on each axis) in the last frame.
     area: Rect,
+    /// The names written on the pad in the last frame, with where.
+    labels: Vec<(String, Rect)>,
 }
 
 impl Default for StrikePad {
@@ -35,8 +44,44 @@ impl Default for StrikePad {
         Self {
             velocity: DEFAULT_VELOCITY,
             held: false,
+            rect: Rect::NOTHING,
             area: Rect::NOTHING,
+            labels: Vec::new(),
         }
+    }
+}
+
+/// Where the pad lies on screen in one frame.
+#[derive(Clone, Copy)]
+struct PadGeometry {
+    /// The whole pad.
+    rect: Rect,
+    /// The area positions map to (0 to 1 on each axis; y up).
+    area: Rect,
+    /// Whether the object is a plane (else a line).
+    two_d: bool,
+}
+
+impl PadGeometry {
+    /// The screen point of position `(x, y)`.
+    fn to_screen(self, x: f32, y: f32) -> Pos2 {
+        let area = self.area;
+        if self.two_d {
+            pos2(
+                area.left() + area.width() * x,
+                area.bottom() - area.height() * y,
+            )
+        } else {
+            pos2(area.left() + area.width() * x, area.center().y)
+        }
+    }
+
+    /// The position under screen point `p`, clamped to the object (0 to 1 on each axis).
+    fn position_at(self, p: Pos2) -> (f32, f32) {
+        let area = self.area;
+        let x = ((p.x - area.left()) / area.width()).clamp(0.0, 1.0);
+        let y = ((area.bottom() - p.y) / area.height()).clamp(0.0, 1.0);
+        (x, y)
     }
 }
 
@@ -44,6 +89,17 @@ impl StrikePad {
     /// The area positions map to (0 to 1 on each axis; y up) in the last frame.
     pub fn area(&self) -> Rect {
         self.area
+    }
+
+    /// The whole pad in the last frame.
+    pub fn rect(&self) -> Rect {
+        self.rect
+    }
+
+    /// The positions' names written in the last frame, with where (a name with no room is
+    /// left out and shown on hover).
+    pub fn labels(&self) -> &[(String, Rect)] {
+        &self.labels
     }
 
     /// Forgets a held strike (the window closed under the pointer); returns whether one was.
@@ -60,39 +116,63 @@ impl StrikePad {
         names: &[String],
         host: &Host,
     ) {
-        let Host {
-            params,
-            setter,
-            shared,
-        } = *host;
         let two_d = positions.dims() == 2;
+        let font = FontId::proportional(NAME_SIZE);
+        let row_height = ui.ctx().fonts_mut(|f| f.row_height(&font));
         let size = if two_d {
             let side = size.x.min(size.y - 24.0).max(60.0);
             vec2(side, side)
         } else {
-            vec2(size.x, LINE_HEIGHT)
+            // The line in the middle, with its rows of names above and below.
+            vec2(size.x, 2.0 * (labels::line_room(row_height) + 2.0))
         };
         let (rect, response) = ui.allocate_exact_size(size, Sense::click_and_drag());
-        // Room for the names of the end positions of a line.
+        // A line leaves room beside its ends for the names of positions there.
         let area = if two_d {
             rect.shrink(INSET)
         } else {
             rect.shrink2(vec2(3.0 * INSET, INSET))
         };
-        self.area = area;
-        let to_screen = |x: f32, y: f32| {
-            if two_d {
-                pos2(
-                    area.left() + area.width() * x,
-                    area.bottom() - area.height() * y,
-                )
-            } else {
-                pos2(area.left() + area.width() * x, area.center().y)
-            }
+        (self.rect, self.area) = (rect, area);
+        let pad = PadGeometry { rect, area, two_d };
+        self.handle_pointer(ui, &response, pad, host);
+
+        let painter = ui.painter_at(rect);
+        let marks: Vec<Pos2> = positions
+            .coords()
+            .iter()
+            .map(|c| pad.to_screen(c[0] as f32, c[1] as f32))
+            .collect();
+        paint_object(&painter, pad, positions, &marks);
+        self.paint_names(&painter, pad, &marks, names, &font);
+        self.paint_strike(&painter, pad, host.params);
+
+        let named = response.hover_pos().and_then(|p| {
+            let near = marks.iter().position(|m| m.distance(p) <= HOVER_RADIUS)?;
+            names.get(near)
+        });
+        let hint = "Press to strike here (held until released); drag to move";
+        match named {
+            Some(name) => response.on_hover_text(format!("{name}\n{hint}")),
+            None => response.on_hover_text(hint),
         };
-        let from_screen = |p: Pos2| {
-            let x = ((p.x - area.left()) / area.width()).clamp(0.0, 1.0);
-            let y = ((area.bottom() - p.y) / area.height()).clamp(0.0, 1.0);
+        ui.add(
+            Slider::new(&mut self.velocity, 0.05..=1.0)
+                .text("strike velocity")
+                .fixed_decimals(2),
+        );
+    }
+
+    /// Press: strike there; drag: move the strike point; release: end the note.
+    fn handle_pointer(&mut self, ui: &Ui, response: &Response, pad: PadGeometry, host: &Host) {
+        let Host {
+            params,
+            setter,
+            shared,
+        } = *host;
+        let two_d = pad.two_d;
+        let position = |p: Pos2| {
+            let (x, y) = pad.position_at(p);
             (
                 x,
                 if two_d {
@@ -102,17 +182,16 @@ impl StrikePad {
                 },
             )
         };
-
-        // Press: strike there; drag: move the strike point; release: end the note.
         let (pressed, down) = ui.input(|i| (i.pointer.primary_pressed(), i.pointer.primary_down()));
+        let pointer = ui.input(|i| i.pointer.interact_pos());
         if pressed && response.contains_pointer() {
-            if let Some(p) = ui.input(|i| i.pointer.interact_pos()) {
-                let (x, y) = from_screen(p);
+            if let Some(p) = pointer {
+                let (x, y) = position(p);
                 setter.begin_set_parameter(&params.strike.strike_x);
                 if two_d {
                     setter.begin_set_parameter(&params.strike.strike_y);
                 }
-                self.set_position(params, setter, x, y, two_d);
+                set_position(params, setter, x, y, two_d);
                 shared.request(Audition::Strike {
                     x,
                     y,
@@ -121,9 +200,9 @@ impl StrikePad {
                 self.held = true;
             }
         } else if self.held && down {
-            if let Some(p) = ui.input(|i| i.pointer.interact_pos()) {
-                let (x, y) = from_screen(p);
-                self.set_position(params, setter, x, y, two_d);
+            if let Some(p) = pointer {
+                let (x, y) = position(p);
+                set_position(params, setter, x, y, two_d);
             }
         }
         if self.held && !down {
@@ -134,52 +213,36 @@ impl StrikePad {
                 setter.end_set_parameter(&params.strike.strike_y);
             }
         }
+    }
 
-        let painter = ui.painter_at(rect);
-        painter.rect_filled(rect, CornerRadius::same(4), style::PLOT_BG);
-        let font = FontId::proportional(10.0);
-        if two_d {
-            painter.rect_stroke(
-                area,
-                CornerRadius::ZERO,
-                Stroke::new(1.0, style::GRID),
-                egui::StrokeKind::Middle,
-            );
-        } else {
-            painter.hline(
-                area.x_range(),
-                area.center().y,
-                Stroke::new(2.0, style::GRID),
-            );
-        }
-        // Where a mirrored axis repeats the measured positions, they are drawn again, faint.
-        let [mirror_x, mirror_y] = positions.axes().map(|a| a == StrikeAxis::Mirrored);
-        for c in positions.coords() {
-            let (x, y) = (c[0] as f32, c[1] as f32);
-            let images = [
-                (mirror_x && x < 0.5, 1.0 - x, y),
-                (mirror_y && y < 0.5, x, 1.0 - y),
-                (mirror_x && mirror_y && x < 0.5 && y < 0.5, 1.0 - x, 1.0 - y),
-            ];
-            for (shown, ix, iy) in images {
-                if shown {
-                    painter.circle_stroke(to_screen(ix, iy), 3.5, (1.0, style::POSITION));
-                }
+    /// Writes the positions' names where [`labels::place`] finds them room, and keeps where.
+    fn paint_names(
+        &mut self,
+        painter: &Painter,
+        pad: PadGeometry,
+        marks: &[Pos2],
+        names: &[String],
+        font: &FontId,
+    ) {
+        let galleys: Vec<_> = names
+            .iter()
+            .take(marks.len())
+            .map(|name| painter.layout_no_wrap(name.clone(), font.clone(), style::LABEL))
+            .collect();
+        let sizes: Vec<Vec2> = galleys.iter().map(|g| g.size()).collect();
+        let spots = labels::place(&marks[..galleys.len()], &sizes, pad.rect, pad.two_d);
+        self.labels.clear();
+        for ((galley, spot), name) in galleys.into_iter().zip(spots).zip(names) {
+            if let Some(spot) = spot {
+                painter.galley(spot.min, galley, style::LABEL);
+                self.labels.push((name.clone(), spot));
             }
         }
-        for (k, c) in positions.coords().iter().enumerate() {
-            let p = to_screen(c[0] as f32, c[1] as f32);
-            painter.circle_filled(p, 4.0, style::POSITION);
-            if let Some(name) = names.get(k) {
-                let (offset, align) = if two_d || k % 2 == 0 {
-                    (vec2(0.0, 7.0), Align2::CENTER_TOP)
-                } else {
-                    (vec2(0.0, -7.0), Align2::CENTER_BOTTOM)
-                };
-                painter.text(p + offset, align, name, font.clone(), style::LABEL);
-            }
-        }
-        let strike = to_screen(
+    }
+
+    /// The strike point: a ring and a cross, filled while a pad strike is held.
+    fn paint_strike(&self, painter: &Painter, pad: PadGeometry, params: &ModalParams) {
+        let strike = pad.to_screen(
             params.strike.strike_x.value(),
             params.strike.strike_y.value(),
         );
@@ -196,26 +259,52 @@ impl StrikePad {
         if self.held {
             painter.circle_filled(strike, 4.0, colour);
         }
-        response.on_hover_text("Press to strike here (held until released); drag to move");
-        ui.add(
-            Slider::new(&mut self.velocity, 0.05..=1.0)
-                .text("strike velocity")
-                .fixed_decimals(2),
+    }
+}
+
+/// The object (a line or a square) and its positions' marks, with faint marks where a mirrored
+/// axis repeats them.
+fn paint_object(painter: &Painter, pad: PadGeometry, positions: &PositionMap, marks: &[Pos2]) {
+    painter.rect_filled(pad.rect, CornerRadius::same(4), style::PLOT_BG);
+    let area = pad.area;
+    if pad.two_d {
+        painter.rect_stroke(
+            area,
+            CornerRadius::ZERO,
+            Stroke::new(1.0, style::GRID),
+            egui::StrokeKind::Middle,
+        );
+    } else {
+        painter.hline(
+            area.x_range(),
+            area.center().y,
+            Stroke::new(2.0, style::GRID),
         );
     }
-
-    /// Sets the strike position parameters (y only on 2-D banks).
-    fn set_position(
-        &self,
-        params: &ModalParams,
-        setter: &ParamSetter,
-        x: f32,
-        y: f32,
-        two_d: bool,
-    ) {
-        setter.set_parameter(&params.strike.strike_x, x);
-        if two_d {
-            setter.set_parameter(&params.strike.strike_y, y);
+    let [mirror_x, mirror_y] = positions.axes().map(|a| a == StrikeAxis::Mirrored);
+    for c in positions.coords() {
+        let (x, y) = (c[0] as f32, c[1] as f32);
+        let images = [
+            (mirror_x && x < 0.5, 1.0 - x, y),
+            (mirror_y && y < 0.5, x, 1.0 - y),
+            (mirror_x && mirror_y && x < 0.5 && y < 0.5, 1.0 - x, 1.0 - y),
+        ];
+        for (shown, ix, iy) in images {
+            if shown {
+                let faint: (f32, Color32) = (1.0, style::POSITION);
+                painter.circle_stroke(pad.to_screen(ix, iy), 3.5, faint);
+            }
         }
+    }
+    for &mark in marks {
+        painter.circle_filled(mark, labels::MARK_RADIUS, style::POSITION);
+    }
+}
+
+/// Sets the strike position parameters (y only on 2-D banks).
+fn set_position(params: &ModalParams, setter: &ParamSetter, x: f32, y: f32, two_d: bool) {
+    setter.set_parameter(&params.strike.strike_x, x);
+    if two_d {
+        setter.set_parameter(&params.strike.strike_y, y);
     }
 }

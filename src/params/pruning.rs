@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use nice_plug::prelude::*;
 
-use super::decibels;
+use super::{decibels, RoundedSteps};
 use crate::engine::{
     Controls, ANALYSIS_FRAME_RANGE_MS, MASKING_OFFSET_RANGE_DB, MAX_MODE_BUDGET,
     MAX_TARGET_LOAD_PCT, PLAYBACK_LEVEL_RANGE_DB_SPL,
@@ -61,7 +61,7 @@ impl PruningParams {
                 },
             )
             .with_unit(" ms")
-            .with_step_size(1.0),
+            .with_rounded_steps(1.0),
             mode_budget: IntParam::new(
                 "Mode budget",
                 controls.mode_budget as i32,

@@ -12,6 +12,21 @@ use crate::engine::{MidiMessage, Note, NoteEvent as EngineEvent, NoteExpression}
 /// A key number that names no voice: events with a note id but no key find their voice by id.
 const NO_KEY: u8 = u8::MAX;
 
+/// VST3's number for channel pressure among MIDI controllers (`kAfterTouch`, VST3 SDK
+/// `ivstmidicontrollers.h`).
+const VST3_CHANNEL_PRESSURE: u8 = 128;
+
+/// VST3's number for pitch bend among MIDI controllers (`kPitchBend`, the same header).
+const VST3_PITCH_BEND: u8 = 129;
+
+/// The MIDI controllers the engine reads ([`crate::engine::MidiInput`]), numbered as VST3 numbers
+/// them: the mod wheel (CC 1), the sustain pedal (CC 64), slide (CC 74), all sound off (CC 120),
+/// all notes off (CC 123), channel pressure and pitch bend. VST3 has no MIDI controller events: a
+/// host turns each into a change of a hidden parameter standing for it on its channel, and the
+/// plugin lists those parameters for these controllers alone.
+pub const VST3_MIDI_CONTROLLERS: [u8; 7] =
+    [1, 64, 74, 120, 123, VST3_CHANNEL_PRESSURE, VST3_PITCH_BEND];
+
 /// The engine's note for a host note; `None` for a wildcard key without an id.
 fn note_of(voice_id: VoiceID, channel: Channel, key: Key) -> Option<Note> {
     let id = voice_id.id();
@@ -221,5 +236,60 @@ impl<K: Kind> ModalPlugin<K> {
         if self.events.len() < MAX_EVENTS {
             self.events.push(event);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::{Controls, MidiInput};
+
+    /// What the engine makes of a note held and let go, with the message `controller` makes
+    /// sent at full while the note is held and at zero once it is let go.
+    fn played_with(controller: &dyn Fn(f32) -> Option<MidiMessage>) -> Vec<EngineEvent> {
+        let note = Note::key(60);
+        let script = [
+            (
+                0,
+                Some(MidiMessage::NoteOn {
+                    note,
+                    velocity: 1.0,
+                }),
+            ),
+            (1, controller(1.0)),
+            (2, Some(MidiMessage::NoteOff { note })),
+            (3, controller(0.0)),
+        ];
+        let mut input = MidiInput::default();
+        let mut events = Vec::new();
+        for (time, message) in script {
+            if let Some(message) = message {
+                input.read(time, message, &Controls::default(), |e| events.push(e));
+            }
+        }
+        events
+    }
+
+    /// The controllers listed for VST3 are exactly those that change what the engine plays.
+    #[test]
+    fn the_vst3_controllers_are_the_ones_the_engine_reads() {
+        let plain = played_with(&|_| None);
+        let channel = 0;
+        let read: Vec<u8> = (0..=VST3_PITCH_BEND)
+            .filter(|&number| {
+                let events = played_with(&|value| {
+                    Some(match number {
+                        VST3_CHANNEL_PRESSURE => MidiMessage::ChannelPressure {
+                            channel,
+                            pressure: value,
+                        },
+                        VST3_PITCH_BEND => MidiMessage::PitchBend { channel, value },
+                        cc => MidiMessage::Control { channel, cc, value },
+                    })
+                });
+                events != plain
+            })
+            .collect();
+        assert_eq!(read, VST3_MIDI_CONTROLLERS);
     }
 }

@@ -18,6 +18,7 @@ use nice_plug::prelude::*;
 use nice_plug_egui::{EguiEditor, EguiEditorState};
 
 pub use bank_loader::{build_engine, LoadedEngine};
+pub use events::VST3_MIDI_CONTROLLERS;
 pub use kind::{Effect, Instrument, Kind};
 
 use crate::dsp::denormal::flush_subnormals;
@@ -607,6 +608,7 @@ impl<K: Kind> ClapPlugin for ModalPlugin<K> {
 impl<K: Kind> Vst3Plugin for ModalPlugin<K> {
     const VST3_CLASS_ID: [u8; 16] = K::VST3_CLASS_ID;
     const VST3_SUBCATEGORIES: &'static [Vst3SubCategory] = K::VST3_SUBCATEGORIES;
+    const VST3_MIDI_CONTROLLERS: &'static [u8] = &VST3_MIDI_CONTROLLERS;
 }
 
 nice_export_clap!(ModalResonator, ModalResonatorFx);
