@@ -7,9 +7,9 @@ use std::sync::RwLock;
 use nice_plug::params::persist::PersistentField;
 use nice_plug::prelude::*;
 
-use crate::dsp::ExciterKind;
 use crate::engine::{
-    control_range, Controls, Material, VoiceModulation, MATERIAL_Q_RANGE, MAX_POLYPHONY,
+    control_range, Controls, ExciterKind, Material, VoiceModulation, MATERIAL_Q_RANGE,
+    MAX_POLYPHONY,
 };
 use crate::model::factory::{factory_bank, DEFAULT_FACTORY_BANK};
 
