@@ -21,6 +21,8 @@ const DEFAULT_VELOCITY: f32 = 0.8;
 const INSET: f32 = 12.0;
 /// Size of the positions' names, in points.
 const NAME_SIZE: f32 = 10.0;
+/// Space between a line's outermost rows of names and the pad's edges, in points.
+const EDGE_CLEARANCE: f32 = 2.0;
 /// How near a position's mark the pointer must be for the pad to name it, in points.
 const HOVER_RADIUS: f32 = 8.0;
 
@@ -123,8 +125,11 @@ impl StrikePad {
             let side = size.x.min(size.y - 24.0).max(60.0);
             vec2(side, side)
         } else {
-            // The line in the middle, with its rows of names above and below.
-            vec2(size.x, 2.0 * (labels::line_room(row_height) + 2.0))
+            // The line in the middle, with its rows of names above and below, clear of the edges.
+            vec2(
+                size.x,
+                2.0 * (labels::line_room(row_height) + EDGE_CLEARANCE),
+            )
         };
         let (rect, response) = ui.allocate_exact_size(size, Sense::click_and_drag());
         // A line leaves room beside its ends for the names of positions there.
