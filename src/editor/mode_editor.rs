@@ -66,7 +66,10 @@ pub fn show(
                 if response.changed() {
                     session.set_decay_per_s(i, t60_to_decay(t60_s));
                 }
-            } else if ui.button("rings forever: set 10 s").clicked() {
+            } else if ui
+                .button("690 s (decay 0 plays at the engine's floor): set 10 s")
+                .clicked()
+            {
                 session.set_decay_per_s(i, t60_to_decay(10.0));
             }
             ui.end_row();
