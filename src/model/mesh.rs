@@ -16,6 +16,7 @@
 
 pub mod assemble;
 pub mod element;
+pub mod error;
 pub mod generate;
 pub mod lanczos;
 pub mod matching;
@@ -24,9 +25,9 @@ pub mod surface;
 pub mod to_bank;
 pub mod voxel;
 
-use std::fmt;
 use std::time::{Duration, Instant};
 
+pub use error::MeshError;
 pub use lanczos::SolveStage;
 pub use matching::{combine_with_recording, MatchReport};
 pub use read::{parse_surface, write_obj};
@@ -53,177 +54,6 @@ const RIGID_HZ: f64 = 1.0;
 
 /// Rigid motions of a free solid: three translations, three rotations.
 const RIGID_MOTIONS: usize = 6;
-
-/// Why a mesh could not be made into modes.
-#[derive(Debug, Clone, PartialEq)]
-pub enum MeshError {
-    /// The file cannot be read as a mesh.
-    Syntax {
-        /// Line (OBJ, ASCII STL) or triangle (binary STL), from 1.
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// No triangles.
-    Empty,
-    /// A face refers to a vertex that does not exist.
-    BadIndex {
-        /// Face index, from 0.
-        face: usize,
-        /// The vertex index it names.
-        vertex: usize,
-        /// Number of vertices.
-        count: usize,
-    },
-    /// A triangle without area.
-    Degenerate {
-        /// Face index.
-        face: usize,
-        /// Its vertices.
-        vertices: [u32; 3],
-    },
-    /// An edge with a triangle on one side only: the surface has a hole.
-    Open {
-        /// The face with the edge.
-        face: usize,
-        /// The edge's vertices.
-        edge: [u32; 2],
-    },
-    /// An edge shared by more than two triangles.
-    NonManifold {
-        /// The faces sharing it.
-        faces: Vec<usize>,
-        /// The edge's vertices.
-        edge: [u32; 2],
-    },
-    /// Two neighbouring triangles facing opposite ways.
-    Inconsistent {
-        /// The two faces.
-        faces: [usize; 2],
-        /// Their shared edge.
-        edge: [u32; 2],
-    },
-    /// The triangles face inward.
-    InsideOut {
-        /// The signed volume, negative.
-        volume_m3: f64,
-    },
-    /// The surface is closed but encloses (almost) nothing: it is folded flat.
-    NoVolume {
-        /// The enclosed volume.
-        volume_m3: f64,
-    },
-    /// More triangles, cells or elements than can be solved.
-    TooLarge {
-        /// What there are too many of.
-        what: &'static str,
-        /// How many.
-        count: usize,
-        /// The limit.
-        limit: usize,
-    },
-    /// No voxel centre falls inside the surface.
-    TooThin {
-        /// Voxel edge in metres.
-        voxel_m: f64,
-    },
-    /// The voxels fall apart into several pieces.
-    Pieces {
-        /// How many.
-        pieces: usize,
-        /// Voxel edge in metres.
-        voxel_m: f64,
-    },
-    /// A setting is out of range.
-    BadSetting {
-        /// Its name.
-        name: &'static str,
-        /// What was expected.
-        reason: String,
-    },
-    /// The eigensolver failed.
-    Solver(String),
-    /// No elastic mode lies below the frequency limit.
-    NoModes {
-        /// The limit in Hz.
-        max_freq_hz: f64,
-    },
-}
-
-impl fmt::Display for MeshError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::Syntax { line, message } => write!(f, "line {line}: {message}"),
-            Self::Empty => write!(f, "the mesh has no faces"),
-            Self::BadIndex {
-                face,
-                vertex,
-                count,
-            } => write!(
-                f,
-                "face {face} names vertex {vertex}, but there are only {count} vertices"
-            ),
-            Self::Degenerate { face, vertices } => write!(
-                f,
-                "face {face} (vertices {vertices:?}) has no area: remove degenerate triangles"
-            ),
-            Self::Open { face, edge } => write!(
-                f,
-                "the surface is not closed: edge {edge:?} of face {face} borders no other face \
-                 (a hole); a solid needs a watertight surface"
-            ),
-            Self::NonManifold { faces, edge } => write!(
-                f,
-                "the surface is not manifold: edge {edge:?} is shared by {} faces {faces:?}, \
-                 expected 2",
-                faces.len()
-            ),
-            Self::Inconsistent { faces, edge } => write!(
-                f,
-                "faces {} and {} face opposite ways across edge {edge:?}: orient every face \
-                 counter-clockwise seen from outside",
-                faces[0], faces[1]
-            ),
-            Self::InsideOut { volume_m3 } => write!(
-                f,
-                "the surface is inside-out (its faces point inward, signed volume {volume_m3:.3e} \
-                 m^3): flip the normals"
-            ),
-            Self::NoVolume { volume_m3 } => write!(
-                f,
-                "the surface encloses no volume ({volume_m3:.3e} m^3): it is folded flat, or \
-                 its units are far too small (see --scale)"
-            ),
-            Self::TooLarge { what, count, limit } => write!(
-                f,
-                "too large: {count} {what}, at most {limit}; use fewer elements or a coarser mesh"
-            ),
-            Self::TooThin { voxel_m } => write!(
-                f,
-                "no voxel of {:.3} mm fits inside the surface: the object is thinner than a voxel; \
-                 use more elements",
-                voxel_m * 1e3
-            ),
-            Self::Pieces { pieces, voxel_m } => write!(
-                f,
-                "at voxels of {:.3} mm the object falls apart into {pieces} pieces: a wall or \
-                 a joint is thinner than a voxel (or the mesh holds separate objects); use more \
-                 elements",
-                voxel_m * 1e3
-            ),
-            Self::BadSetting { name, reason } => write!(f, "{name}: {reason}"),
-            Self::Solver(reason) => write!(f, "the eigensolver failed: {reason}"),
-            Self::NoModes { max_freq_hz } => {
-                write!(
-                    f,
-                    "no mode below {max_freq_hz} Hz: the object is too small or too stiff"
-                )
-            }
-        }
-    }
-}
-
-impl std::error::Error for MeshError {}
 
 /// A region of the solid held still.
 #[derive(Debug, Clone, PartialEq)]
