@@ -1914,3 +1914,21 @@ fn mesh_refuses_bad_meshes_and_options_cleanly() {
         assert_failed_cleanly(&out, &[expected], dir.path(), &extra);
     }
 }
+
+#[test]
+fn mesh_says_a_binary_stl_is_truncated() {
+    let dir = dir_with_bank();
+    write_box_stl(&dir.path().join("box.stl"), [0.1, 0.1, 0.1]);
+    let bytes = std::fs::read(dir.path().join("box.stl")).unwrap();
+    std::fs::write(dir.path().join("cut.stl"), &bytes[..bytes.len() / 2]).unwrap();
+    let out = run(dir.path(), &["mesh", "cut.stl", "-o", "out.json"]);
+    assert_failed_cleanly(
+        &out,
+        &[
+            "cut.stl: a binary STL whose header gives 12 triangles",
+            "truncated",
+        ],
+        dir.path(),
+        &["box.stl", "cut.stl"],
+    );
+}

@@ -656,3 +656,33 @@ fn a_mesh_matched_to_a_recording_at_one_point_has_the_object_s_gains_at_the_othe
         "{unpaired} modes with one gain everywhere"
     );
 }
+
+#[test]
+fn a_truncated_binary_stl_is_called_truncated() {
+    let surface = generate::cuboid([0.1, 0.02, 0.01]);
+    let mut binary = vec![0u8; 80];
+    binary.extend((surface.triangles.len() as u32).to_le_bytes());
+    for t in 0..surface.triangles.len() {
+        binary.extend([0u8; 12]);
+        for c in surface.corners(t) {
+            for x in c {
+                binary.extend((x as f32).to_le_bytes());
+            }
+        }
+        binary.extend([0u8; 2]);
+    }
+    assert!(parse_surface("box.stl", &binary).is_ok());
+    let cut = &binary[..binary.len() - 70];
+    let error = parse_surface("box.stl", cut).expect_err("truncated");
+    assert_eq!(
+        error.to_string(),
+        "a binary STL whose header gives 12 triangles (684 bytes) but the file has 614 bytes \
+         (10 whole triangles): it is truncated"
+    );
+    let error = parse_surface("box.stl", &binary[..40]).expect_err("no header");
+    assert!(error.to_string().contains("truncated"), "{error}");
+    let mut longer = binary.clone();
+    longer.extend([0u8; 7]);
+    let error = parse_surface("box.stl", &longer).expect_err("too long");
+    assert!(error.to_string().contains("7 more"), "{error}");
+}

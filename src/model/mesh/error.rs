@@ -2,6 +2,8 @@
 
 use std::fmt;
 
+use super::read;
+
 /// Why a mesh could not be made into modes.
 #[derive(Debug, Clone, PartialEq)]
 pub enum MeshError {
@@ -11,6 +13,15 @@ pub enum MeshError {
         line: usize,
         /// What is wrong.
         message: String,
+    },
+    /// Neither text nor a binary STL of the size its header gives.
+    BinarySize {
+        /// The triangles the header gives (`None`: too short for a header).
+        triangles: Option<usize>,
+        /// The size those take, in bytes.
+        expected_bytes: usize,
+        /// The file's size, in bytes.
+        found_bytes: usize,
     },
     /// No triangles.
     Empty,
@@ -102,6 +113,15 @@ impl fmt::Display for MeshError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::Syntax { line, message } => write!(f, "line {line}: {message}"),
+            Self::BinarySize {
+                triangles,
+                expected_bytes,
+                found_bytes,
+            } => f.write_str(&read::binary_size_message(
+                *triangles,
+                *expected_bytes,
+                *found_bytes,
+            )),
             Self::Empty => write!(f, "the mesh has no faces"),
             Self::BadIndex {
                 face,
