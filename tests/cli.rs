@@ -1932,3 +1932,26 @@ fn mesh_says_a_binary_stl_is_truncated() {
         &["box.stl", "cut.stl"],
     );
 }
+
+#[test]
+fn mesh_refuses_too_many_elements_before_reading_the_mesh() {
+    let dir = dir_with_bank();
+    let out = run(
+        dir.path(),
+        &[
+            "mesh",
+            "missing.stl",
+            "--elements",
+            "200001",
+            "-o",
+            "out.json",
+        ],
+    );
+    assert_failed_cleanly(
+        &out,
+        &["--elements: too large: 200001 elements, at most 200000"],
+        dir.path(),
+        &[],
+    );
+    assert!(!stderr(&out).contains("missing.stl"), "{}", stderr(&out));
+}

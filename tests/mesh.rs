@@ -6,8 +6,8 @@ use std::f64::consts::TAU;
 
 use modal_resonator::model::materials::{Material, STEEL};
 use modal_resonator::model::mesh::{
-    bank_from_modes, generate, parse_surface, solve_modes, strike_points, write_obj, Clamp,
-    MeshError, MeshModes, MeshSettings, MeshSource, StrikeRequest, Surface,
+    bank_from_modes, generate, parse_surface, solve_modes, solve_modes_within, strike_points,
+    write_obj, Clamp, MeshError, MeshModes, MeshSettings, MeshSource, StrikeRequest, Surface,
 };
 use modal_resonator::model::shapes::{CircularPlate, ModeLimits, PlateEdge, Shape};
 use modal_resonator::model::Position;
@@ -685,4 +685,43 @@ fn a_truncated_binary_stl_is_called_truncated() {
     longer.extend([0u8; 7]);
     let error = parse_surface("box.stl", &longer).expect_err("too long");
     assert!(error.to_string().contains("7 more"), "{error}");
+}
+
+#[test]
+fn a_solve_too_large_for_its_memory_is_refused_before_it_factorises() {
+    let bar = generate::cuboid(BAR_M);
+    let settings = steel(1000, 8);
+    let solved = solve_modes(&bar, &settings, &mut |_| {}).expect("the bar solves");
+    let needed = solved.stats.memory_bytes;
+    println!("the bar at 1000 elements: about {needed} bytes");
+    // At least its factor and its Lanczos basis.
+    let floor = 8 * (solved.stats.factor_entries + 8 * solved.stats.dofs);
+    assert!(needed > floor, "{needed} bytes, less than {floor}");
+    let error =
+        solve_modes_within(&bar, &settings, needed - 1, &mut |_| {}).expect_err("a byte short");
+    assert_eq!(
+        error,
+        MeshError::TooMuchMemory {
+            needed_bytes: needed,
+            limit_bytes: needed - 1
+        }
+    );
+    assert!(error.to_string().contains("GiB allowed"), "{error}");
+    let within = solve_modes_within(&bar, &settings, needed, &mut |_| {}).expect("just fits");
+    assert_eq!(within.freqs_hz, solved.freqs_hz);
+    // More elements than any solve may have are refused before the surface is even filled.
+    let mut stages = 0;
+    let error = solve_modes(&bar, &steel(200_001, 4), &mut |_| stages += 1).expect_err("too many");
+    assert!(
+        matches!(
+            error,
+            MeshError::TooLarge {
+                what: "elements",
+                count: 200_001,
+                ..
+            }
+        ),
+        "{error}"
+    );
+    assert_eq!(stages, 0, "nothing is computed");
 }

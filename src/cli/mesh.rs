@@ -10,9 +10,10 @@ use modal_resonator::model::fit::{
 };
 use modal_resonator::model::materials::Material;
 use modal_resonator::model::mesh::{
-    bank_from_modes, combine_with_recording, parse_surface, solve_modes, spread_strike_points,
-    strike_points, Clamp, MeshModes, MeshSettings, MeshSource, MeshStage, SolveStage,
-    StrikeRequest, Surface, DEFAULT_ELEMENTS, MAX_MODES,
+    bank_from_modes, check_elements, combine_with_recording, parse_surface, solve_modes_within,
+    spread_strike_points, strike_points, Clamp, MeshError, MeshModes, MeshSettings, MeshSource,
+    MeshStage, SolveStage, StrikeRequest, Surface, DEFAULT_ELEMENTS, DEFAULT_MAX_SOLVE_BYTES,
+    MAX_MODES,
 };
 use modal_resonator::model::shapes::{ModeLimits, MAX_AUDIBLE_HZ};
 use modal_resonator::model::summary::note_name;
@@ -97,6 +98,11 @@ pub(super) struct MeshArgs {
 /// Builds the bank, saves it atomically and prints what it is. Nothing is written on failure.
 pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
     check_output_dir(&args.output)?;
+    // Before anything is read: the solve's memory grows faster than the element count.
+    check_elements(args.elements).map_err(|e| match e {
+        MeshError::BadSetting { reason, .. } => format!("--elements: {reason}"),
+        other => format!("--elements: {other}"),
+    })?;
     let place = args.input.display().to_string();
     let (surface, source) = read_mesh(args)?;
     let mut settings = MeshSettings {
@@ -328,11 +334,23 @@ fn material(args: &MeshArgs) -> Material {
     material
 }
 
+/// The most memory a solve may hold: [`DEFAULT_MAX_SOLVE_BYTES`], or half the machine's
+/// memory when that is less (read from `/proc/meminfo` where there is one).
+fn memory_limit_bytes() -> usize {
+    let machine = std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|text| {
+            let line = text.lines().find(|l| l.starts_with("MemTotal:"))?;
+            let kib: usize = line.split_whitespace().nth(1)?.parse().ok()?;
+            Some(kib.saturating_mul(1024))
+        });
+    machine.map_or(DEFAULT_MAX_SOLVE_BYTES, |bytes| {
+        (bytes / 2).min(DEFAULT_MAX_SOLVE_BYTES)
+    })
+}
+
 /// Solves with a progress bar for each stage.
-fn solve_with_progress(
-    surface: &Surface,
-    settings: &MeshSettings,
-) -> Result<MeshModes, modal_resonator::model::mesh::MeshError> {
+fn solve_with_progress(surface: &Surface, settings: &MeshSettings) -> Result<MeshModes, MeshError> {
     let mut bar: Option<(&'static str, Progress)> = None;
     let mut stage_bar = |label: &'static str, done: f64| {
         if bar.as_ref().is_none_or(|(l, _)| *l != label) {
@@ -345,7 +363,8 @@ fn solve_with_progress(
             progress.set(done);
         }
     };
-    let modes = solve_modes(surface, settings, &mut |stage| match stage {
+    let limit = memory_limit_bytes();
+    let modes = solve_modes_within(surface, settings, limit, &mut |stage| match stage {
         MeshStage::Voxelising => stage_bar("voxelising", 0.0),
         MeshStage::Assembling { .. } => stage_bar("assembling", 0.0),
         MeshStage::Solving(SolveStage::Factorising) => stage_bar("factorising", 0.0),
@@ -466,12 +485,14 @@ fn report(args: &MeshArgs, modes: &MeshModes, bank: &modal_resonator::model::Ban
     let say = |line: &str| say(&args.output, line);
     say(&bank.description);
     say(&format!(
-        "  {} elements of {:.3} mm, {} degrees of freedom, {} rigid motions left out; \
-         voxels {:.2} s, assembly {:.2} s, factorisation {:.2} s, {} Lanczos steps {:.2} s",
+        "  {} elements of {:.3} mm, {} degrees of freedom, {} rigid motions left out, about \
+         {:.0} MiB; voxels {:.2} s, assembly {:.2} s, factorisation {:.2} s, {} Lanczos steps \
+         {:.2} s",
         stats.elements,
         stats.voxel_m * 1e3,
         stats.dofs,
         stats.rigid_modes,
+        stats.memory_bytes as f64 / (1u64 << 20) as f64,
         stats.voxelising.as_secs_f64(),
         stats.assembling.as_secs_f64(),
         stats.factorising.as_secs_f64(),

@@ -55,6 +55,10 @@ const RIGID_HZ: f64 = 1.0;
 /// Rigid motions of a free solid: three translations, three rotations.
 const RIGID_MOTIONS: usize = 6;
 
+/// At most this many bytes may a solve hold ([`solve_modes`]): a larger one is refused before
+/// its numeric factorisation starts.
+pub const DEFAULT_MAX_SOLVE_BYTES: usize = 8 << 30;
+
 /// A region of the solid held still.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Clamp {
@@ -121,6 +125,8 @@ pub struct SolveStats {
     pub steps: usize,
     /// Rigid motions found and left out.
     pub rigid_modes: usize,
+    /// Bytes the solve was expected to hold at its peak.
+    pub memory_bytes: usize,
     /// Time to fill the surface with voxels.
     pub voxelising: Duration,
     /// Time to assemble the matrices.
@@ -160,10 +166,22 @@ pub struct MeshModes {
     pub stats: SolveStats,
 }
 
-/// The lowest vibration modes of the solid bounded by `surface` (checked here).
+/// The lowest vibration modes of the solid bounded by `surface` (checked here), the solve
+/// holding at most [`DEFAULT_MAX_SOLVE_BYTES`].
 pub fn solve_modes(
     surface: &Surface,
     settings: &MeshSettings,
+    progress: &mut dyn FnMut(MeshStage),
+) -> Result<MeshModes, MeshError> {
+    solve_modes_within(surface, settings, DEFAULT_MAX_SOLVE_BYTES, progress)
+}
+
+/// The lowest vibration modes of the solid bounded by `surface` (checked here); a solve that
+/// would hold more than `max_bytes` is refused before its numeric factorisation.
+pub fn solve_modes_within(
+    surface: &Surface,
+    settings: &MeshSettings,
+    max_bytes: usize,
     progress: &mut dyn FnMut(MeshStage),
 ) -> Result<MeshModes, MeshError> {
     surface.check()?;
@@ -207,11 +225,13 @@ pub fn solve_modes(
         &system,
         settings.modes + RIGID_MOTIONS,
         shift,
+        max_bytes,
         &mut |stage| progress(MeshStage::Solving(stage)),
     )?;
     stats.factorising = pairs.factorising;
     stats.iterating = started.elapsed().saturating_sub(pairs.factorising);
     stats.factor_entries = pairs.factor_entries;
+    stats.memory_bytes = pairs.memory_bytes;
     stats.steps = pairs.steps;
 
     let (freqs_hz, shapes, rigid_modes) = without_rigid_motions(pairs, settings.modes);
@@ -234,14 +254,27 @@ impl MeshSettings {
                 reason: format!("expected 1 to {MAX_MODES}, found {}", self.modes),
             });
         }
-        if self.elements < 8 {
-            return Err(MeshError::BadSetting {
-                name: "elements",
-                reason: format!("expected at least 8, found {}", self.elements),
-            });
-        }
-        Ok(())
+        check_elements(self.elements)
     }
+}
+
+/// `Ok` when `elements` voxels may be asked for: checked before anything is read or computed,
+/// as the solve's memory grows faster than the count.
+pub fn check_elements(elements: usize) -> Result<(), MeshError> {
+    if elements < 8 {
+        return Err(MeshError::BadSetting {
+            name: "elements",
+            reason: format!("expected at least 8, found {elements}"),
+        });
+    }
+    if elements > voxel::MAX_ELEMENTS {
+        return Err(MeshError::TooLarge {
+            what: "elements",
+            count: elements,
+            limit: voxel::MAX_ELEMENTS,
+        });
+    }
+    Ok(())
 }
 
 /// The first `count` vibration modes of `pairs` (frequencies in Hz and shapes) and the number of

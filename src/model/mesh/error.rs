@@ -100,6 +100,13 @@ pub enum MeshError {
         /// What was expected.
         reason: String,
     },
+    /// The solve would hold more memory than allowed.
+    TooMuchMemory {
+        /// The estimate, in bytes.
+        needed_bytes: usize,
+        /// The limit, in bytes.
+        limit_bytes: usize,
+    },
     /// The eigensolver failed.
     Solver(String),
     /// No elastic mode lies below the frequency limit.
@@ -166,6 +173,7 @@ impl fmt::Display for MeshError {
             | Self::TooThin { .. }
             | Self::Pieces { .. }
             | Self::BadSetting { .. }
+            | Self::TooMuchMemory { .. }
             | Self::Solver(..)
             | Self::NoModes { .. } => self.fmt_solving(f),
         }
@@ -195,6 +203,16 @@ impl MeshError {
                 voxel_m * 1e3
             ),
             Self::BadSetting { name, reason } => write!(f, "{name}: {reason}"),
+            Self::TooMuchMemory {
+                needed_bytes,
+                limit_bytes,
+            } => write!(
+                f,
+                "the solve would hold about {:.2} GiB, more than the {:.2} GiB allowed; use \
+                 fewer elements or modes",
+                *needed_bytes as f64 / GIB,
+                *limit_bytes as f64 / GIB
+            ),
             Self::Solver(reason) => write!(f, "the eigensolver failed: {reason}"),
             Self::NoModes { max_freq_hz } => {
                 write!(
@@ -209,3 +227,6 @@ impl MeshError {
 }
 
 impl std::error::Error for MeshError {}
+
+/// Bytes in a GiB, for messages.
+const GIB: f64 = (1u64 << 30) as f64;
