@@ -1955,3 +1955,64 @@ fn mesh_refuses_too_many_elements_before_reading_the_mesh() {
     );
     assert!(!stderr(&out).contains("missing.stl"), "{}", stderr(&out));
 }
+
+#[test]
+fn mesh_in_millimetres_read_as_metres_is_refused_naming_scale() {
+    let dir = dir_with_bank();
+    write_box_stl(&dir.path().join("bar.stl"), [300.0, 30.0, 10.0]);
+    let out = run(
+        dir.path(),
+        &[
+            "mesh",
+            "bar.stl",
+            "--elements",
+            "1000",
+            "--modes",
+            "4",
+            "-o",
+            "bar.json",
+        ],
+    );
+    // The 300 m bar's first bending mode, 576.5 Hz / 1000, is found and refused, not dropped
+    // as a seventh rigid motion.
+    assert_failed_cleanly(
+        &out,
+        &[
+            "warning: bar.stl: at --scale 1: the object is 300 m across",
+            "lowest mode 0.57",
+            "under the 1 Hz floor",
+            "try --scale 0.001",
+        ],
+        dir.path(),
+        &["bar.stl"],
+    );
+    // Scaled a thousand times too small, every mode lies far above 20 kHz: said so, with the
+    // lowest and the size.
+    let out = run(
+        dir.path(),
+        &[
+            "mesh",
+            "bar.stl",
+            "--scale",
+            "1e-6",
+            "--elements",
+            "1000",
+            "-o",
+            "bar.json",
+        ],
+    );
+    assert_failed_cleanly(
+        &out,
+        &[
+            "no mode below 20000 Hz: the lowest is 57",
+            "the object is 0.3 mm across: is --scale right?",
+        ],
+        dir.path(),
+        &["bar.stl"],
+    );
+    assert!(
+        !stderr(&out).contains("positive definite"),
+        "{}",
+        stderr(&out)
+    );
+}

@@ -725,3 +725,106 @@ fn a_solve_too_large_for_its_memory_is_refused_before_it_factorises() {
     );
     assert_eq!(stages, 0, "nothing is computed");
 }
+
+/// `solve` with the bar's vertices at `corners` (indices into the generated cuboid's vertices)
+/// held, each as `--fix vertices=` holds one.
+fn bar_held_at(corners: &[usize], elements: usize) -> MeshModes {
+    let bar = generate::cuboid(BAR_M);
+    let clamps = corners
+        .iter()
+        .map(|&v| Clamp::Near {
+            point_m: bar.vertices[v],
+        })
+        .collect();
+    solve(&bar, elements, clamps, 4)
+}
+
+#[test]
+fn rigid_motions_are_counted_from_what_holds_the_object() {
+    // The cuboid's vertex c sits at (c & 1, c >> 1 & 1, c >> 2 & 1) times the bar's size.
+    let free = solve(&generate::cuboid(BAR_M), 1000, vec![], 4);
+    assert_eq!(free.stats.rigid_modes, 6);
+    assert!(
+        free.stats.rigid_max_hz < 1e-3 * free.freqs_hz[0],
+        "a free bar's rigid motions at up to {} Hz, its first mode at {} Hz",
+        free.stats.rigid_max_hz,
+        free.freqs_hz[0]
+    );
+    assert_eq!(free.rigid_warning(), None);
+    // One held vertex leaves the three rotations about it; two the rotation about the line
+    // through them; three not on one line, or a plane, none.
+    for (corners, rigid) in [(&[0][..], 3), (&[0, 1][..], 1), (&[0, 1, 6][..], 0)] {
+        let held = bar_held_at(corners, 1000);
+        println!(
+            "held at {corners:?}: {} rigid, left out up to {:.2} Hz, modes {:.1?}",
+            held.stats.rigid_modes, held.stats.rigid_max_hz, held.freqs_hz
+        );
+        assert_eq!(
+            held.stats.rigid_modes, rigid,
+            "held at vertices {corners:?}"
+        );
+        // A vertex holds the corners within a voxel of it: the bar turns about that patch at a
+        // low but real frequency, which the bank must not pass off as rigid in silence.
+        assert_eq!(held.rigid_warning().is_some(), rigid > 0, "{corners:?}");
+    }
+    let clamped = solve(
+        &generate::cuboid(BAR_M),
+        1000,
+        vec![Clamp::Below { axis: 0, at_m: 0.0 }],
+        4,
+    );
+    assert_eq!(clamped.stats.rigid_modes, 0);
+    // A cantilever's first mode, 1.875^2 / 4.730^2 of the free bar's.
+    let expected = free.freqs_hz[0] * (1.875_104 / FREE_BEAM_ROOTS[0]).powi(2);
+    assert_within("cantilever", clamped.freqs_hz[0], expected, 0.03);
+}
+
+#[test]
+fn a_bar_a_thousand_times_too_large_is_refused_under_the_floor_naming_scale() {
+    // The bar's millimetres read as metres: 300 m long, its first mode 576.5 Hz / 1000.
+    let huge = generate::cuboid(BAR_M.map(|x| x * 1000.0));
+    let error = solve_modes(&huge, &steel(1000, 4), &mut |_| {}).expect_err("under the floor");
+    let MeshError::BelowFloor { lowest_hz, size_m } = error else {
+        panic!("expected BelowFloor, found {error}");
+    };
+    assert_within(
+        "the 300 m bar's first mode",
+        lowest_hz,
+        euler_bernoulli_hz(0, BAR_M[2]) / 1000.0,
+        0.03,
+    );
+    assert_eq!(size_m, 300.0);
+    let message = error.to_string();
+    assert!(message.contains("--scale 0.001"), "{message}");
+    assert!(message.contains("under the 1 Hz floor"), "{message}");
+}
+
+#[test]
+fn a_bar_too_small_to_sound_says_what_is_wrong() {
+    // 0.3 mm long: every mode far above 20 kHz; the factorisation holds at any size.
+    let tiny = generate::cuboid(BAR_M.map(|x| x * 1e-3));
+    let modes = solve(&tiny, 1000, vec![], 4);
+    assert_eq!(modes.stats.rigid_modes, 6);
+    let settings = steel(1000, 4);
+    let source = MeshSource {
+        file_name: "tiny.stl".to_string(),
+        sha256: "0".repeat(64),
+        scale: 1e-6,
+    };
+    let points = strike_points(
+        &tiny,
+        &[StrikeRequest {
+            name: "end".to_string(),
+            point_m: [0.0, 0.0, 0.0],
+        }],
+    );
+    let limits = ModeLimits::default();
+    let error = bank_from_modes("Tiny", &modes, &settings, &points, &limits, &source)
+        .expect_err("no audible mode");
+    let message = error.to_string();
+    assert!(
+        matches!(error, MeshError::NoModes { lowest_hz, .. } if lowest_hz > 500e3),
+        "{message}"
+    );
+    assert!(message.contains("--scale"), "{message}");
+}

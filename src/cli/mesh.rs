@@ -11,9 +11,9 @@ use modal_resonator::model::fit::{
 use modal_resonator::model::materials::Material;
 use modal_resonator::model::mesh::{
     bank_from_modes, check_elements, combine_with_recording, parse_surface, solve_modes_within,
-    spread_strike_points, strike_points, Clamp, MeshError, MeshModes, MeshSettings, MeshSource,
-    MeshStage, SolveStage, StrikeRequest, Surface, DEFAULT_ELEMENTS, DEFAULT_MAX_SOLVE_BYTES,
-    MAX_MODES,
+    spread_strike_points, strike_points, unit_warning, Clamp, MeshError, MeshModes, MeshSettings,
+    MeshSource, MeshStage, SolveStage, StrikeRequest, Surface, DEFAULT_ELEMENTS,
+    DEFAULT_MAX_SOLVE_BYTES, MAX_MODES,
 };
 use modal_resonator::model::shapes::{ModeLimits, MAX_AUDIBLE_HZ};
 use modal_resonator::model::summary::note_name;
@@ -105,6 +105,9 @@ pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
     })?;
     let place = args.input.display().to_string();
     let (surface, source) = read_mesh(args)?;
+    if let Some(warning) = unit_warning(&surface) {
+        eprintln!("warning: {place}: at --scale {}: {warning}", args.scale);
+    }
     let mut settings = MeshSettings {
         material: material(args),
         elements: args.elements,
@@ -135,6 +138,9 @@ pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
         None => None,
     };
     let modes = solve_up_to_limit(args, &surface, &mut settings)?;
+    if let Some(warning) = modes.rigid_warning() {
+        eprintln!("warning: {place}: {warning}");
+    }
     let limits = ModeLimits {
         max_freq_hz: args.max_hz.unwrap_or(MAX_AUDIBLE_HZ),
         max_modes: settings.modes,

@@ -5,7 +5,8 @@
 //! ([`voxel::voxelize`]), each cube an 8-node brick of linear elasticity with incompatible
 //! bending modes ([`element`]); their stiffness and mass are assembled sparse ([`assemble`]),
 //! and the lowest modes of `K phi = omega^2 M phi` come from shift-invert Lanczos on a sparse
-//! Cholesky factorisation ([`lanczos`]). Rigid motions of a free object are found and left out.
+//! Cholesky factorisation ([`lanczos`]). The rigid motions the clamps leave ([`rigid`]: six for a
+//! free object) come out first, at zero, and are left out.
 //! A mode's gain at a strike point is its mass-normalised shape along the surface normal there,
 //! over `omega` (seed 000 eq. 3.11, as the analytic shapes do); decays come from the material.
 //!
@@ -21,13 +22,14 @@ pub mod generate;
 pub mod lanczos;
 pub mod matching;
 pub mod read;
+pub mod rigid;
 pub mod surface;
 pub mod to_bank;
 pub mod voxel;
 
 use std::time::{Duration, Instant};
 
-pub use error::MeshError;
+pub use error::{scale_hint, unit_warning, MeshError};
 pub use lanczos::SolveStage;
 pub use matching::{combine_with_recording, MatchReport};
 pub use read::{parse_surface, write_obj};
@@ -38,6 +40,7 @@ pub use to_bank::{
 pub use voxel::Voxels;
 
 use crate::model::materials::Material;
+use crate::model::validate::MODE_FREQ_HZ;
 
 /// Default number of solid voxels: 100 modes of it solve in seconds.
 pub const DEFAULT_ELEMENTS: usize = 20_000;
@@ -45,15 +48,17 @@ pub const DEFAULT_ELEMENTS: usize = 20_000;
 /// Most modes one solve finds.
 pub const MAX_MODES: usize = 500;
 
-/// The Lanczos shift, `-(2 pi 20 Hz)^2`: below every audible mode and below the rigid motions'
-/// zero, so `K - sigma M` is positive definite.
-const SHIFT_HZ: f64 = 20.0;
+/// The Lanczos shift is `-(2 pi f)^2` with `f` this share of `c / D` (the material's rod wave
+/// speed over the bounding box's diagonal): 20 Hz for the 300 mm steel bar. Below zero, so
+/// `K - sigma M` is positive definite with the rigid motions' zeros; scaled with the object, so
+/// its conditioning is the same at any size (stiffness over mass goes as 1 / size^2) and the
+/// lowest modes of a large object (a 300 m bar's 0.57 Hz) lie well above it, apart from the
+/// zeros, as the bar's 576 Hz does above 20 Hz.
+const SHIFT_SHARE: f64 = 1.2e-3;
 
-/// Modes below this frequency are rigid motions (numerically zero), not vibrations.
-const RIGID_HZ: f64 = 1.0;
-
-/// Rigid motions of a free solid: three translations, three rotations.
-const RIGID_MOTIONS: usize = 6;
+/// A motion left out as rigid whose frequency exceeds this share of the lowest mode kept is
+/// not rigid: the clamps hold it only weakly (a pivot), and [`MeshModes::rigid_warning`] says so.
+const RIGID_SHARE: f64 = 0.01;
 
 /// At most this many bytes may a solve hold ([`solve_modes`]): a larger one is refused before
 /// its numeric factorisation starts.
@@ -123,8 +128,11 @@ pub struct SolveStats {
     pub factor_entries: usize,
     /// Lanczos steps.
     pub steps: usize,
-    /// Rigid motions found and left out.
+    /// Rigid motions the clamps leave (six for a free object), left out.
     pub rigid_modes: usize,
+    /// The highest frequency among the motions left out as rigid, in Hz: near zero when they
+    /// are rigid, higher when a clamp holds the object only at a pivot.
+    pub rigid_max_hz: f64,
     /// Bytes the solve was expected to hold at its peak.
     pub memory_bytes: usize,
     /// Time to fill the surface with voxels.
@@ -205,26 +213,19 @@ pub fn solve_modes_within(
     progress(MeshStage::Assembling {
         elements: stats.elements,
     });
-    let m = &settings.material;
-    let brick = element::brick_matrices(
-        voxels.size_m,
-        m.density_kg_m3,
-        m.youngs_modulus_pa,
-        m.poisson_ratio,
-    );
-    let system = assemble::assemble(&voxels, &brick, |p| {
-        settings.clamps.iter().any(|c| c.holds(p, voxel_m))
-    });
+    let (system, rigid) = assemble_clamped(&voxels, settings, voxel_m);
     stats.dofs = system.dofs;
     stats.matrix_entries = system.entries();
+    stats.rigid_modes = rigid;
     stats.assembling = started.elapsed();
 
     let started = Instant::now();
-    let shift = -(std::f64::consts::TAU * SHIFT_HZ).powi(2);
+    let m = &settings.material;
+    let shift_hz = SHIFT_SHARE * m.rod_wave_speed_m_per_s() / diagonal_m(&voxels);
     let pairs = lanczos::lowest_eigenpairs(
         &system,
-        settings.modes + RIGID_MOTIONS,
-        shift,
+        settings.modes + rigid,
+        -(std::f64::consts::TAU * shift_hz).powi(2),
         max_bytes,
         &mut |stage| progress(MeshStage::Solving(stage)),
     )?;
@@ -234,28 +235,67 @@ pub fn solve_modes_within(
     stats.memory_bytes = pairs.memory_bytes;
     stats.steps = pairs.steps;
 
-    let (freqs_hz, shapes, rigid_modes) = without_rigid_motions(pairs, settings.modes);
-    stats.rigid_modes = rigid_modes;
-    Ok(MeshModes {
+    let (freqs_hz, shapes, rigid_max_hz) = without_rigid_motions(pairs, rigid, settings.modes)?;
+    stats.rigid_max_hz = rigid_max_hz;
+    let modes = MeshModes {
         voxels,
         corner_dof: system.corner_dof,
         freqs_hz,
         shapes,
         stats,
-    })
+    };
+    if modes.freqs_hz[0] < MODE_FREQ_HZ.min {
+        return Err(MeshError::BelowFloor {
+            lowest_hz: modes.freqs_hz[0],
+            size_m: modes.longest_side_m(),
+        });
+    }
+    Ok(modes)
 }
 
-impl MeshSettings {
-    /// `Ok` when the settings can be solved.
-    fn check(&self) -> Result<(), MeshError> {
-        if !(1..=MAX_MODES).contains(&self.modes) {
-            return Err(MeshError::BadSetting {
-                name: "modes",
-                reason: format!("expected 1 to {MAX_MODES}, found {}", self.modes),
-            });
+/// The system of `voxels` with the corners `settings.clamps` hold left out, and the number of
+/// rigid motions those clamps leave ([`rigid::rigid_motions_left`]): a plane holds the grid
+/// corners on its side, a point the corners within a voxel of it, as a pin at the point.
+fn assemble_clamped(
+    voxels: &Voxels,
+    settings: &MeshSettings,
+    voxel_m: f64,
+) -> (assemble::System, usize) {
+    let m = &settings.material;
+    let brick = element::brick_matrices(
+        voxels.size_m,
+        m.density_kg_m3,
+        m.youngs_modulus_pa,
+        m.poisson_ratio,
+    );
+    let mut held_m = Vec::new();
+    let mut pinned = vec![false; settings.clamps.len()];
+    let system = assemble::assemble(voxels, &brick, |p| {
+        let mut held = false;
+        for (c, clamp) in settings.clamps.iter().enumerate() {
+            if clamp.holds(p, voxel_m) {
+                held = true;
+                match clamp {
+                    Clamp::Near { .. } => pinned[c] = true,
+                    Clamp::Below { .. } | Clamp::Above { .. } => held_m.push(p),
+                }
+            }
         }
-        check_elements(self.elements)
+        held
+    });
+    for (clamp, _) in settings.clamps.iter().zip(&pinned).filter(|(_, &p)| p) {
+        if let Clamp::Near { point_m } = clamp {
+            held_m.push(*point_m);
+        }
     }
+    let rigid = rigid::rigid_motions_left(&held_m, diagonal_m(voxels));
+    (system, rigid)
+}
+
+/// The diagonal of the voxel grid (the surface's bounding box) in metres.
+fn diagonal_m(voxels: &Voxels) -> f64 {
+    let sides = [0, 1, 2].map(|a| voxels.size_m[a] * voxels.dims[a] as f64);
+    surface::norm(sides)
 }
 
 /// `Ok` when `elements` voxels may be asked for: checked before anything is read or computed,
@@ -277,28 +317,77 @@ pub fn check_elements(elements: usize) -> Result<(), MeshError> {
     Ok(())
 }
 
-/// The first `count` vibration modes of `pairs` (frequencies in Hz and shapes) and the number of
-/// rigid motions among them, left out.
+impl MeshSettings {
+    /// `Ok` when the settings can be solved.
+    fn check(&self) -> Result<(), MeshError> {
+        if !(1..=MAX_MODES).contains(&self.modes) {
+            return Err(MeshError::BadSetting {
+                name: "modes",
+                reason: format!("expected 1 to {MAX_MODES}, found {}", self.modes),
+            });
+        }
+        check_elements(self.elements)
+    }
+}
+
+/// The `count` vibration modes of `pairs` after its `rigid` lowest (frequencies in Hz and
+/// shapes), and the highest frequency among those left out (0 with none).
+#[allow(clippy::type_complexity)]
 fn without_rigid_motions(
     pairs: lanczos::Eigenpairs,
+    rigid: usize,
     count: usize,
-) -> (Vec<f64>, Vec<Vec<f64>>, usize) {
-    let rigid_limit = (std::f64::consts::TAU * RIGID_HZ).powi(2);
-    let mut freqs_hz = Vec::new();
-    let mut shapes = Vec::new();
-    let mut rigid = 0;
-    for (value, vector) in pairs.values.into_iter().zip(pairs.vectors) {
-        if value < rigid_limit {
-            rigid += 1;
-        } else if freqs_hz.len() < count {
-            freqs_hz.push(value.sqrt() / std::f64::consts::TAU);
-            shapes.push(vector);
-        }
+) -> Result<(Vec<f64>, Vec<Vec<f64>>, f64), MeshError> {
+    let to_hz = |value: f64| value.max(0.0).sqrt() / std::f64::consts::TAU;
+    if pairs.values.len() <= rigid {
+        return Err(MeshError::Solver(format!(
+            "{} eigenpairs found, none beyond the {rigid} rigid motions",
+            pairs.values.len()
+        )));
     }
-    (freqs_hz, shapes, rigid)
+    let rigid_max_hz = pairs.values[..rigid]
+        .iter()
+        .copied()
+        .map(to_hz)
+        .fold(0.0, f64::max);
+    let freqs_hz = pairs.values[rigid..]
+        .iter()
+        .take(count)
+        .copied()
+        .map(to_hz)
+        .collect();
+    let shapes = pairs.vectors.into_iter().skip(rigid).take(count).collect();
+    Ok((freqs_hz, shapes, rigid_max_hz))
 }
 
 impl MeshModes {
+    /// The longest side of the voxel grid (the surface's bounding box) in metres.
+    pub fn longest_side_m(&self) -> f64 {
+        let v = &self.voxels;
+        (0..3)
+            .map(|a| v.size_m[a] * v.dims[a] as f64)
+            .fold(0.0, f64::max)
+    }
+
+    /// A warning when the motions left out as rigid are not near zero (above 1 % of the lowest
+    /// mode kept): what holds the object does so only at a pivot, whose motions about it ring at
+    /// a low but real frequency.
+    pub fn rigid_warning(&self) -> Option<String> {
+        let s = &self.stats;
+        let lowest = self.freqs_hz.first().copied().unwrap_or(0.0);
+        (s.rigid_modes > 0 && s.rigid_max_hz > RIGID_SHARE * lowest).then(|| {
+            format!(
+                "the {} motions left out as rigid reach {:.2} Hz, more than {:.0} % of the lowest \
+                 mode kept ({lowest:.2} Hz): they are not rigid; an object held only at a point \
+                 or along a line turns about it at such a frequency (hold a patch: a plane, or \
+                 vertices not on one line)",
+                s.rigid_modes,
+                s.rigid_max_hz,
+                100.0 * RIGID_SHARE
+            )
+        })
+    }
+
     /// Each mode's displacement at `point_m` (on or near the solid) along the unit vector
     /// `direction`, from the voxel nearest the point (trilinear between its corners).
     pub fn displacement_along(&self, point_m: [f64; 3], direction: [f64; 3]) -> Vec<f64> {

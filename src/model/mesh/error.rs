@@ -1,8 +1,18 @@
-//! Why a mesh could not be made into modes.
+//! Why a mesh could not be made into modes, and the advice on its unit that a size far from
+//! any instrument's calls for.
 
 use std::fmt;
 
 use super::read;
+use super::surface::Surface;
+use crate::model::validate::MODE_FREQ_HZ;
+
+/// An object larger than this (its bounding box's longest side) is probably in the wrong unit:
+/// a millimetre file read as metres.
+const LARGEST_LIKELY_M: f64 = 10.0;
+
+/// An object smaller than this is probably in the wrong unit.
+const SMALLEST_LIKELY_M: f64 = 1e-3;
 
 /// Why a mesh could not be made into modes.
 #[derive(Debug, Clone, PartialEq)]
@@ -109,10 +119,21 @@ pub enum MeshError {
     },
     /// The eigensolver failed.
     Solver(String),
+    /// The lowest elastic mode lies under the lowest frequency a bank's modes may have.
+    BelowFloor {
+        /// The lowest mode in Hz.
+        lowest_hz: f64,
+        /// The longest side of the object's bounding box in metres.
+        size_m: f64,
+    },
     /// No elastic mode lies below the frequency limit.
     NoModes {
         /// The limit in Hz.
         max_freq_hz: f64,
+        /// The lowest mode found, in Hz.
+        lowest_hz: f64,
+        /// The longest side of the object's bounding box in metres.
+        size_m: f64,
     },
 }
 
@@ -175,6 +196,7 @@ impl fmt::Display for MeshError {
             | Self::BadSetting { .. }
             | Self::TooMuchMemory { .. }
             | Self::Solver(..)
+            | Self::BelowFloor { .. }
             | Self::NoModes { .. } => self.fmt_solving(f),
         }
     }
@@ -214,13 +236,21 @@ impl MeshError {
                 *limit_bytes as f64 / GIB
             ),
             Self::Solver(reason) => write!(f, "the eigensolver failed: {reason}"),
-            Self::NoModes { max_freq_hz } => {
-                write!(
-                    f,
-                    "no mode below {max_freq_hz} Hz: the object is too small or too stiff"
-                )
-            }
-
+            Self::BelowFloor { lowest_hz, size_m } => write!(
+                f,
+                "lowest mode {lowest_hz:.3} Hz: under the {} Hz floor a bank's modes start at; {}",
+                MODE_FREQ_HZ.min,
+                size_advice(*size_m, "too large, too soft or too loosely held")
+            ),
+            Self::NoModes {
+                max_freq_hz,
+                lowest_hz,
+                size_m,
+            } => write!(
+                f,
+                "no mode below {max_freq_hz} Hz: the lowest is {lowest_hz:.0} Hz; {}",
+                size_advice(*size_m, "too small or too stiff")
+            ),
             surface => unreachable!("{surface:?} is written by fmt"),
         }
     }
@@ -230,3 +260,59 @@ impl std::error::Error for MeshError {}
 
 /// Bytes in a GiB, for messages.
 const GIB: f64 = (1u64 << 30) as f64;
+
+/// What to try when an object whose bounding box's longest side is `size_m` (metres, once
+/// scaled) is so large or so small that its file is probably in another unit, naming its size;
+/// `None` when its size is likely.
+pub fn scale_hint(size_m: f64) -> Option<String> {
+    if size_m > LARGEST_LIKELY_M {
+        Some(format!(
+            "the object is {} across: is the file in millimetres? try --scale 0.001",
+            length(size_m)
+        ))
+    } else if size_m < SMALLEST_LIKELY_M {
+        Some(format!(
+            "the object is {} across: is --scale right? (1 for a file in metres, 0.001 in \
+             millimetres)",
+            length(size_m)
+        ))
+    } else {
+        None
+    }
+}
+
+/// Why an object whose bounding box's longest side is `size_m` does not sound: its unit
+/// ([`scale_hint`]), or else it is `what` (too large, too small...) to sound.
+fn size_advice(size_m: f64, what: &str) -> String {
+    scale_hint(size_m)
+        .unwrap_or_else(|| format!("the object ({} across) is {what} to sound", length(size_m)))
+}
+
+/// A warning when `surface` (in metres) is so large or so small that its file is probably in
+/// another unit, naming its bounding box.
+pub fn unit_warning(surface: &Surface) -> Option<String> {
+    let (lo, hi) = surface.bounds();
+    let sides = [0, 1, 2].map(|a| hi[a] - lo[a]);
+    let longest = sides.iter().fold(0.0f64, |a, &b| a.max(b));
+    scale_hint(longest).map(|hint| {
+        let [x, y, z] = sides.map(length);
+        format!("{hint} (its bounding box is {x} x {y} x {z})")
+    })
+}
+
+/// A length in metres to 4 significant digits, in metres from 1 m, else in millimetres.
+fn length(m: f64) -> String {
+    let (value, unit) = if m >= 1.0 { (m, "m") } else { (m * 1e3, "mm") };
+    let digits = if value > 0.0 {
+        (3 - value.log10().floor() as i32).clamp(0, 12) as usize
+    } else {
+        0
+    };
+    let text = format!("{value:.digits$}");
+    let text = if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &text
+    };
+    format!("{text} {unit}")
+}

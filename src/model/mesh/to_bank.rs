@@ -134,7 +134,15 @@ pub fn bank_from_modes(
         .collect();
     let material = &settings.material;
     let bank_modes = finish_modes(shaped, material, limits).map_err(|e| match e {
-        ShapeError::NoModes { max_freq_hz } => MeshError::NoModes { max_freq_hz },
+        ShapeError::NoModes { max_freq_hz } => MeshError::NoModes {
+            max_freq_hz,
+            lowest_hz: modes.freqs_hz[0],
+            size_m: modes.longest_side_m(),
+        },
+        ShapeError::BelowFloor { lowest_hz, .. } => MeshError::BelowFloor {
+            lowest_hz,
+            size_m: modes.longest_side_m(),
+        },
         other => MeshError::BadSetting {
             name: "mesh",
             reason: other.to_string(),
