@@ -2016,3 +2016,43 @@ fn mesh_in_millimetres_read_as_metres_is_refused_naming_scale() {
         stderr(&out)
     );
 }
+
+#[test]
+fn mesh_default_strike_points_sound_a_bar_s_fundamental() {
+    let dir = dir_with_bank();
+    write_box_stl(&dir.path().join("bar.stl"), [300.0, 30.0, 10.0]);
+    let out = run(
+        dir.path(),
+        &[
+            "mesh",
+            "bar.stl",
+            "--scale",
+            "0.001",
+            "--elements",
+            "2000",
+            "--modes",
+            "12",
+            "-o",
+            "bar.json",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
+    let bank = modal_resonator::model::load_bank_file(&dir.path().join("bar.json")).unwrap();
+    assert_eq!(bank.positions.len(), 6);
+    // The first bending mode (Euler-Bernoulli 576.50 Hz), not the width-bending 1,671 Hz.
+    let root = bank.root_hz.unwrap();
+    assert!(
+        (root / 576.5 - 1.0).abs() < 0.01,
+        "root {root}: {}",
+        stdout(&out)
+    );
+    let first = &bank.modes[0];
+    assert_eq!(first.freq_hz, root);
+    let peak_at_default = bank
+        .modes
+        .iter()
+        .map(|m| m.gains[0].abs())
+        .fold(0.0, f64::max);
+    assert_eq!(first.gains[0].abs(), peak_at_default, "{:?}", bank.modes);
+}

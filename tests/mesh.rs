@@ -6,8 +6,9 @@ use std::f64::consts::TAU;
 
 use modal_resonator::model::materials::{Material, STEEL};
 use modal_resonator::model::mesh::{
-    bank_from_modes, generate, parse_surface, solve_modes, solve_modes_within, strike_points,
-    write_obj, Clamp, MeshError, MeshModes, MeshSettings, MeshSource, StrikeRequest, Surface,
+    bank_from_modes, generate, parse_surface, solve_modes, solve_modes_within,
+    spread_strike_points, strike_points, write_obj, Clamp, MeshError, MeshModes, MeshSettings,
+    MeshSource, StrikeRequest, Surface,
 };
 use modal_resonator::model::shapes::{CircularPlate, ModeLimits, PlateEdge, Shape};
 use modal_resonator::model::Position;
@@ -827,4 +828,64 @@ fn a_bar_too_small_to_sound_says_what_is_wrong() {
         "{message}"
     );
     assert!(message.contains("--scale"), "{message}");
+}
+
+#[test]
+fn default_strike_points_sound_a_bar_s_first_bending_mode() {
+    let bar = generate::cuboid(BAR_M);
+    let modes = solve(&bar, 2000, vec![], 12);
+    let points = spread_strike_points(&bar, &modes, 6);
+    assert_eq!(points.len(), 6);
+    let source = MeshSource {
+        file_name: "bar.obj".to_string(),
+        sha256: "0".repeat(64),
+        scale: 1.0,
+    };
+    let settings = steel(2000, 12);
+    let bank = bank_from_modes(
+        "Bar",
+        &modes,
+        &settings,
+        &points,
+        &ModeLimits::default(),
+        &source,
+    )
+    .expect("a bank");
+    let first_bending = bar_modes_of(&modes, BarMotion::Thin)[0];
+    assert_within(
+        "the first bending mode",
+        first_bending,
+        euler_bernoulli_hz(0, BAR_M[2]),
+        0.02,
+    );
+    let root = bank.root_hz.expect("a root");
+    assert_eq!(root, first_bending, "the bank's root");
+    let k = bank
+        .modes
+        .iter()
+        .position(|m| m.freq_hz == first_bending)
+        .expect("the first bending mode is in the bank");
+    // Its level at each point against the point's strongest mode.
+    let levels_db: Vec<f64> = (0..points.len())
+        .map(|p| {
+            let peak = bank
+                .modes
+                .iter()
+                .map(|m| m.gains[p].abs())
+                .fold(0.0, f64::max);
+            20.0 * (bank.modes[k].gains[p].abs() / peak).log10()
+        })
+        .collect();
+    for (point, level) in points.iter().zip(&levels_db) {
+        println!(
+            "{} at {:.4?} (normal {:.2?}): first bending {level:+.1} dB",
+            point.name, point.point_m, point.normal
+        );
+    }
+    assert!(
+        levels_db[0] > -1.0,
+        "the default strike: {levels_db:.1?} dB"
+    );
+    let well = levels_db.iter().filter(|&&l| l > -3.0).count();
+    assert!(well >= 3, "points within 3 dB: {levels_db:.1?}");
 }

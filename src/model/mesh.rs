@@ -23,6 +23,7 @@ pub mod lanczos;
 pub mod matching;
 pub mod read;
 pub mod rigid;
+pub mod strike;
 pub mod surface;
 pub mod to_bank;
 pub mod voxel;
@@ -33,10 +34,9 @@ pub use error::{scale_hint, unit_warning, MeshError};
 pub use lanczos::SolveStage;
 pub use matching::{combine_with_recording, MatchReport};
 pub use read::{parse_surface, write_obj};
+pub use strike::{spread_strike_points, strike_points, StrikePoint, StrikeRequest};
 pub use surface::Surface;
-pub use to_bank::{
-    bank_from_modes, spread_strike_points, strike_points, MeshSource, StrikePoint, StrikeRequest,
-};
+pub use to_bank::{bank_from_modes, MeshSource};
 pub use voxel::Voxels;
 
 use crate::model::materials::Material;
