@@ -2192,3 +2192,145 @@ fn mesh_refuses_bad_meshes_and_options_cleanly() {
         assert_failed_cleanly(&out, &[expected], dir.path(), &extra);
     }
 }
+
+#[test]
+fn mesh_says_a_binary_stl_is_truncated() {
+    let dir = dir_with_bank();
+    write_box_stl(&dir.path().join("box.stl"), [0.1, 0.1, 0.1]);
+    let bytes = std::fs::read(dir.path().join("box.stl")).unwrap();
+    std::fs::write(dir.path().join("cut.stl"), &bytes[..bytes.len() / 2]).unwrap();
+    let out = run(dir.path(), &["mesh", "cut.stl", "-o", "out.json"]);
+    assert_failed_cleanly(
+        &out,
+        &[
+            "cut.stl: a binary STL whose header gives 12 triangles",
+            "truncated",
+        ],
+        dir.path(),
+        &["box.stl", "cut.stl"],
+    );
+}
+
+#[test]
+fn mesh_refuses_too_many_elements_before_reading_the_mesh() {
+    let dir = dir_with_bank();
+    let out = run(
+        dir.path(),
+        &[
+            "mesh",
+            "missing.stl",
+            "--elements",
+            "200001",
+            "-o",
+            "out.json",
+        ],
+    );
+    assert_failed_cleanly(
+        &out,
+        &["--elements: too large: 200001 elements, at most 200000"],
+        dir.path(),
+        &[],
+    );
+    assert!(!stderr(&out).contains("missing.stl"), "{}", stderr(&out));
+}
+
+#[test]
+fn mesh_in_millimetres_read_as_metres_is_refused_naming_scale() {
+    let dir = dir_with_bank();
+    write_box_stl(&dir.path().join("bar.stl"), [300.0, 30.0, 10.0]);
+    let out = run(
+        dir.path(),
+        &[
+            "mesh",
+            "bar.stl",
+            "--elements",
+            "1000",
+            "--modes",
+            "4",
+            "-o",
+            "bar.json",
+        ],
+    );
+    // The 300 m bar's first bending mode, 576.5 Hz / 1000, is found and refused, not dropped
+    // as a seventh rigid motion.
+    assert_failed_cleanly(
+        &out,
+        &[
+            "warning: bar.stl: at --scale 1: the object is 300 m across",
+            "lowest mode 0.57",
+            "under the 1 Hz floor",
+            "try --scale 0.001",
+        ],
+        dir.path(),
+        &["bar.stl"],
+    );
+    // Scaled a thousand times too small, every mode lies far above 20 kHz: said so, with the
+    // lowest and the size.
+    let out = run(
+        dir.path(),
+        &[
+            "mesh",
+            "bar.stl",
+            "--scale",
+            "1e-6",
+            "--elements",
+            "1000",
+            "-o",
+            "bar.json",
+        ],
+    );
+    assert_failed_cleanly(
+        &out,
+        &[
+            "no mode below 20000 Hz: the lowest is 57",
+            "the object is 0.3 mm across: is --scale right?",
+        ],
+        dir.path(),
+        &["bar.stl"],
+    );
+    assert!(
+        !stderr(&out).contains("positive definite"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn mesh_default_strike_points_sound_a_bar_s_fundamental() {
+    let dir = dir_with_bank();
+    write_box_stl(&dir.path().join("bar.stl"), [300.0, 30.0, 10.0]);
+    let out = run(
+        dir.path(),
+        &[
+            "mesh",
+            "bar.stl",
+            "--scale",
+            "0.001",
+            "--elements",
+            "2000",
+            "--modes",
+            "12",
+            "-o",
+            "bar.json",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
+    let bank = modal_resonator::model::load_bank_file(&dir.path().join("bar.json")).unwrap();
+    assert_eq!(bank.positions.len(), 6);
+    // The first bending mode (Euler-Bernoulli 576.50 Hz), not the width-bending 1,671 Hz.
+    let root = bank.root_hz.unwrap();
+    assert!(
+        (root / 576.5 - 1.0).abs() < 0.01,
+        "root {root}: {}",
+        stdout(&out)
+    );
+    let first = &bank.modes[0];
+    assert_eq!(first.freq_hz, root);
+    let peak_at_default = bank
+        .modes
+        .iter()
+        .map(|m| m.gains[0].abs())
+        .fold(0.0, f64::max);
+    assert_eq!(first.gains[0].abs(), peak_at_default, "{:?}", bank.modes);
+}

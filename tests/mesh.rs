@@ -6,8 +6,9 @@ use std::f64::consts::TAU;
 
 use modal_resonator::model::materials::{Material, STEEL};
 use modal_resonator::model::mesh::{
-    bank_from_modes, generate, parse_surface, solve_modes, strike_points, write_obj, Clamp,
-    MeshError, MeshModes, MeshSettings, MeshSource, StrikeRequest, Surface,
+    bank_from_modes, generate, parse_surface, solve_modes, solve_modes_within,
+    spread_strike_points, strike_points, write_obj, Clamp, MeshError, MeshModes, MeshSettings,
+    MeshSource, StrikeRequest, Surface,
 };
 use modal_resonator::model::shapes::{CircularPlate, ModeLimits, PlateEdge, Shape};
 use modal_resonator::model::Position;
@@ -655,4 +656,236 @@ fn a_mesh_matched_to_a_recording_at_one_point_has_the_object_s_gains_at_the_othe
         unpaired >= report.unpaired_recorded,
         "{unpaired} modes with one gain everywhere"
     );
+}
+
+#[test]
+fn a_truncated_binary_stl_is_called_truncated() {
+    let surface = generate::cuboid([0.1, 0.02, 0.01]);
+    let mut binary = vec![0u8; 80];
+    binary.extend((surface.triangles.len() as u32).to_le_bytes());
+    for t in 0..surface.triangles.len() {
+        binary.extend([0u8; 12]);
+        for c in surface.corners(t) {
+            for x in c {
+                binary.extend((x as f32).to_le_bytes());
+            }
+        }
+        binary.extend([0u8; 2]);
+    }
+    assert!(parse_surface("box.stl", &binary).is_ok());
+    let cut = &binary[..binary.len() - 70];
+    let error = parse_surface("box.stl", cut).expect_err("truncated");
+    assert_eq!(
+        error.to_string(),
+        "a binary STL whose header gives 12 triangles (684 bytes) but the file has 614 bytes \
+         (10 whole triangles): it is truncated"
+    );
+    let error = parse_surface("box.stl", &binary[..40]).expect_err("no header");
+    assert!(error.to_string().contains("truncated"), "{error}");
+    let mut longer = binary.clone();
+    longer.extend([0u8; 7]);
+    let error = parse_surface("box.stl", &longer).expect_err("too long");
+    assert!(error.to_string().contains("7 more"), "{error}");
+}
+
+#[test]
+fn a_solve_too_large_for_its_memory_is_refused_before_it_factorises() {
+    let bar = generate::cuboid(BAR_M);
+    let settings = steel(1000, 8);
+    let solved = solve_modes(&bar, &settings, &mut |_| {}).expect("the bar solves");
+    let needed = solved.stats.memory_bytes;
+    println!("the bar at 1000 elements: about {needed} bytes");
+    // At least its factor and its Lanczos basis.
+    let floor = 8 * (solved.stats.factor_entries + 8 * solved.stats.dofs);
+    assert!(needed > floor, "{needed} bytes, less than {floor}");
+    let error =
+        solve_modes_within(&bar, &settings, needed - 1, &mut |_| {}).expect_err("a byte short");
+    assert_eq!(
+        error,
+        MeshError::TooMuchMemory {
+            needed_bytes: needed,
+            limit_bytes: needed - 1
+        }
+    );
+    assert!(error.to_string().contains("GiB allowed"), "{error}");
+    let within = solve_modes_within(&bar, &settings, needed, &mut |_| {}).expect("just fits");
+    assert_eq!(within.freqs_hz, solved.freqs_hz);
+    // More elements than any solve may have are refused before the surface is even filled.
+    let mut stages = 0;
+    let error = solve_modes(&bar, &steel(200_001, 4), &mut |_| stages += 1).expect_err("too many");
+    assert!(
+        matches!(
+            error,
+            MeshError::TooLarge {
+                what: "elements",
+                count: 200_001,
+                ..
+            }
+        ),
+        "{error}"
+    );
+    assert_eq!(stages, 0, "nothing is computed");
+}
+
+/// `solve` with the bar's vertices at `corners` (indices into the generated cuboid's vertices)
+/// held, each as `--fix vertices=` holds one.
+fn bar_held_at(corners: &[usize], elements: usize) -> MeshModes {
+    let bar = generate::cuboid(BAR_M);
+    let clamps = corners
+        .iter()
+        .map(|&v| Clamp::Near {
+            point_m: bar.vertices[v],
+        })
+        .collect();
+    solve(&bar, elements, clamps, 4)
+}
+
+#[test]
+fn rigid_motions_are_counted_from_what_holds_the_object() {
+    // The cuboid's vertex c sits at (c & 1, c >> 1 & 1, c >> 2 & 1) times the bar's size.
+    let free = solve(&generate::cuboid(BAR_M), 1000, vec![], 4);
+    assert_eq!(free.stats.rigid_modes, 6);
+    assert!(
+        free.stats.rigid_max_hz < 1e-3 * free.freqs_hz[0],
+        "a free bar's rigid motions at up to {} Hz, its first mode at {} Hz",
+        free.stats.rigid_max_hz,
+        free.freqs_hz[0]
+    );
+    assert_eq!(free.rigid_warning(), None);
+    // One held vertex leaves the three rotations about it; two the rotation about the line
+    // through them; three not on one line, or a plane, none.
+    for (corners, rigid) in [(&[0][..], 3), (&[0, 1][..], 1), (&[0, 1, 6][..], 0)] {
+        let held = bar_held_at(corners, 1000);
+        println!(
+            "held at {corners:?}: {} rigid, left out up to {:.2} Hz, modes {:.1?}",
+            held.stats.rigid_modes, held.stats.rigid_max_hz, held.freqs_hz
+        );
+        assert_eq!(
+            held.stats.rigid_modes, rigid,
+            "held at vertices {corners:?}"
+        );
+        // A vertex holds the corners within a voxel of it: the bar turns about that patch at a
+        // low but real frequency, which the bank must not pass off as rigid in silence.
+        assert_eq!(held.rigid_warning().is_some(), rigid > 0, "{corners:?}");
+    }
+    let clamped = solve(
+        &generate::cuboid(BAR_M),
+        1000,
+        vec![Clamp::Below { axis: 0, at_m: 0.0 }],
+        4,
+    );
+    assert_eq!(clamped.stats.rigid_modes, 0);
+    // A cantilever's first mode, 1.875^2 / 4.730^2 of the free bar's.
+    let expected = free.freqs_hz[0] * (1.875_104 / FREE_BEAM_ROOTS[0]).powi(2);
+    assert_within("cantilever", clamped.freqs_hz[0], expected, 0.03);
+}
+
+#[test]
+fn a_bar_a_thousand_times_too_large_is_refused_under_the_floor_naming_scale() {
+    // The bar's millimetres read as metres: 300 m long, its first mode 576.5 Hz / 1000.
+    let huge = generate::cuboid(BAR_M.map(|x| x * 1000.0));
+    let error = solve_modes(&huge, &steel(1000, 4), &mut |_| {}).expect_err("under the floor");
+    let MeshError::BelowFloor { lowest_hz, size_m } = error else {
+        panic!("expected BelowFloor, found {error}");
+    };
+    assert_within(
+        "the 300 m bar's first mode",
+        lowest_hz,
+        euler_bernoulli_hz(0, BAR_M[2]) / 1000.0,
+        0.03,
+    );
+    assert_eq!(size_m, 300.0);
+    let message = error.to_string();
+    assert!(message.contains("--scale 0.001"), "{message}");
+    assert!(message.contains("under the 1 Hz floor"), "{message}");
+}
+
+#[test]
+fn a_bar_too_small_to_sound_says_what_is_wrong() {
+    // 0.3 mm long: every mode far above 20 kHz; the factorisation holds at any size.
+    let tiny = generate::cuboid(BAR_M.map(|x| x * 1e-3));
+    let modes = solve(&tiny, 1000, vec![], 4);
+    assert_eq!(modes.stats.rigid_modes, 6);
+    let settings = steel(1000, 4);
+    let source = MeshSource {
+        file_name: "tiny.stl".to_string(),
+        sha256: "0".repeat(64),
+        scale: 1e-6,
+    };
+    let points = strike_points(
+        &tiny,
+        &[StrikeRequest {
+            name: "end".to_string(),
+            point_m: [0.0, 0.0, 0.0],
+        }],
+    );
+    let limits = ModeLimits::default();
+    let error = bank_from_modes("Tiny", &modes, &settings, &points, &limits, &source)
+        .expect_err("no audible mode");
+    let message = error.to_string();
+    assert!(
+        matches!(error, MeshError::NoModes { lowest_hz, .. } if lowest_hz > 500e3),
+        "{message}"
+    );
+    assert!(message.contains("--scale"), "{message}");
+}
+
+#[test]
+fn default_strike_points_sound_a_bar_s_first_bending_mode() {
+    let bar = generate::cuboid(BAR_M);
+    let modes = solve(&bar, 2000, vec![], 12);
+    let points = spread_strike_points(&bar, &modes, 6);
+    assert_eq!(points.len(), 6);
+    let source = MeshSource {
+        file_name: "bar.obj".to_string(),
+        sha256: "0".repeat(64),
+        scale: 1.0,
+    };
+    let settings = steel(2000, 12);
+    let bank = bank_from_modes(
+        "Bar",
+        &modes,
+        &settings,
+        &points,
+        &ModeLimits::default(),
+        &source,
+    )
+    .expect("a bank");
+    let first_bending = bar_modes_of(&modes, BarMotion::Thin)[0];
+    assert_within(
+        "the first bending mode",
+        first_bending,
+        euler_bernoulli_hz(0, BAR_M[2]),
+        0.02,
+    );
+    let root = bank.root_hz.expect("a root");
+    assert_eq!(root, first_bending, "the bank's root");
+    let k = bank
+        .modes
+        .iter()
+        .position(|m| m.freq_hz == first_bending)
+        .expect("the first bending mode is in the bank");
+    // Its level at each point against the point's strongest mode.
+    let levels_db: Vec<f64> = (0..points.len())
+        .map(|p| {
+            let peak = bank
+                .modes
+                .iter()
+                .map(|m| m.gains[p].abs())
+                .fold(0.0, f64::max);
+            20.0 * (bank.modes[k].gains[p].abs() / peak).log10()
+        })
+        .collect();
+    for (point, level) in points.iter().zip(&levels_db) {
+        println!(
+            "{} at {:.4?} (normal {:.2?}): first bending {level:+.1} dB",
+            point.name, point.point_m, point.normal
+        );
+    }
+    assert!(
+        levels_db[0] > -1.0,
+        "the default strike: {levels_db:.1?} dB"
+    );
+    let well = levels_db.iter().filter(|&&l| l > -3.0).count();
+    assert!(well >= 3, "points within 3 dB: {levels_db:.1?}");
 }

@@ -9,10 +9,12 @@ use modal_resonator::model::fit::{
     fit_bank_with_progress, read_wav_recording, FitOptions, Recording,
 };
 use modal_resonator::model::materials::Material;
+use modal_resonator::model::mesh::strike::spread_names;
 use modal_resonator::model::mesh::{
-    bank_from_modes, combine_with_recording, parse_surface, solve_modes, spread_strike_points,
-    strike_points, Clamp, MeshModes, MeshSettings, MeshSource, MeshStage, SolveStage,
-    StrikeRequest, Surface, DEFAULT_ELEMENTS, MAX_MODES,
+    bank_from_modes, check_elements, combine_with_recording, parse_surface, solve_modes_within,
+    spread_strike_points, strike_points, unit_warning, Clamp, MeshError, MeshModes, MeshSettings,
+    MeshSource, MeshStage, SolveStage, StrikePoint, StrikeRequest, Surface, DEFAULT_ELEMENTS,
+    DEFAULT_MAX_SOLVE_BYTES, MAX_MODES,
 };
 use modal_resonator::model::shapes::{ModeLimits, MAX_AUDIBLE_HZ};
 use modal_resonator::model::summary::note_name;
@@ -63,7 +65,8 @@ pub(super) struct MeshArgs {
     #[arg(long, value_name = "WHERE")]
     fix: Vec<String>,
     /// Strike points: "NAME=X,Y,Z; ..." in file units (moved onto the nearest surface point),
-    /// or a count of points to spread over the surface.
+    /// or a count of points to spread over the surface where its lowest modes move most
+    /// [default: 6].
     #[arg(long, value_name = "LIST")]
     positions: Option<String>,
     /// Combine with a recording of the object struck at one point: "REC.wav=NAME" (a strike
@@ -94,6 +97,32 @@ pub(super) struct MeshArgs {
     license: String,
 }
 
+/// Strike points as asked for: placed now, or spread once the modes are known.
+enum PointPlan {
+    /// Points given by place, on the surface.
+    Given(Vec<StrikePoint>),
+    /// This many points to spread where the lowest modes move most.
+    Spread(usize),
+}
+
+impl PointPlan {
+    /// The points' names, known before the solve.
+    fn names(&self) -> Vec<String> {
+        match self {
+            Self::Given(points) => points.iter().map(|p| p.name.clone()).collect(),
+            Self::Spread(count) => spread_names(*count),
+        }
+    }
+}
+
+/// Where a recording of `--match` was struck.
+enum RecordedAt {
+    /// At the strike point of this index.
+    Point(usize),
+    /// At a place of its own, added as the last strike point.
+    Added(StrikePoint),
+}
+
 /// Builds the bank, saves it atomically and prints what it is. Nothing is written on failure.
 pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
     let recording_file = args
@@ -106,8 +135,16 @@ pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
         inputs.push(("the recording", file));
     }
     check_output("-o", &args.output, &inputs)?;
+    // Before anything is read: the solve's memory grows faster than the element count.
+    check_elements(args.elements).map_err(|e| match e {
+        MeshError::BadSetting { reason, .. } => format!("--elements: {reason}"),
+        other => format!("--elements: {other}"),
+    })?;
     let place = args.input.display().to_string();
     let (surface, source) = read_mesh(args)?;
+    if let Some(warning) = unit_warning(&surface) {
+        eprintln!("warning: {place}: at --scale {}: {warning}", args.scale);
+    }
     let mut settings = MeshSettings {
         material: material(args),
         elements: args.elements,
@@ -115,29 +152,22 @@ pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
         modes: args.modes.unwrap_or(DEFAULT_MODES),
     };
     // Strike points and the recording first: a mistake in them is reported before the solve.
-    let mut points = match args.positions.as_deref() {
-        None => spread_strike_points(&surface, DEFAULT_POINTS),
-        Some(text) => match text.trim().parse::<usize>() {
-            Ok(count) if (1..=64).contains(&count) => {
-                let points = spread_strike_points(&surface, count);
-                if points.len() < count {
-                    eprintln!(
-                        "{place}: only {} strike points can be spread over a surface of {} faces",
-                        points.len(),
-                        surface.triangles.len()
-                    );
-                }
-                points
-            }
-            Ok(count) => return Err(format!("--positions {count}: expected 1 to 64 points")),
-            Err(_) => strike_points(&surface, &parse_points(text, args.scale)?),
-        },
-    };
+    let plan = point_plan(args, &surface)?;
     let recording = match args.match_recording.as_deref() {
-        Some(spec) => Some(recording_point(spec, &surface, &mut points, args.scale)?),
+        Some(spec) => Some(recording_point(spec, &surface, &plan.names(), args.scale)?),
         None => None,
     };
     let modes = solve_up_to_limit(args, &surface, &mut settings)?;
+    if let Some(warning) = modes.rigid_warning() {
+        eprintln!("warning: {place}: {warning}");
+    }
+    let mut points = placed_points(plan, &surface, &modes, &place);
+    let recording = match recording {
+        Some((recording, at, file_name)) => {
+            Some((recording, recorded_point(at, &mut points)?, file_name))
+        }
+        None => None,
+    };
     let limits = ModeLimits {
         max_freq_hz: args.max_hz.unwrap_or(MAX_AUDIBLE_HZ),
         max_modes: settings.modes,
@@ -162,14 +192,70 @@ pub(super) fn run(args: &MeshArgs) -> Result<(), String> {
     Ok(())
 }
 
-/// The recording (read) and the index of its point among `points` for `--match REC=POINT` (a
-/// point given as coordinates is added to `points`).
+/// The index among `points` of where a recording was struck (a place of its own added last).
+fn recorded_point(at: RecordedAt, points: &mut Vec<StrikePoint>) -> Result<usize, String> {
+    match at {
+        // Fewer points than asked are spread over a surface of few faces.
+        RecordedAt::Point(k) if k >= points.len() => Err(format!(
+            "--match: only {} strike points could be spread, so \"p{}\" does not exist",
+            points.len(),
+            k + 1
+        )),
+        RecordedAt::Point(k) => Ok(k),
+        RecordedAt::Added(point) => {
+            points.push(point);
+            Ok(points.len() - 1)
+        }
+    }
+}
+
+/// The strike points `--positions` asks for: places (moved onto the surface now), or a count
+/// of points to spread (default 6) once the modes are known.
+fn point_plan(args: &MeshArgs, surface: &Surface) -> Result<PointPlan, String> {
+    let Some(text) = args.positions.as_deref() else {
+        return Ok(PointPlan::Spread(DEFAULT_POINTS));
+    };
+    match text.trim().parse::<usize>() {
+        Ok(count) if (1..=64).contains(&count) => Ok(PointPlan::Spread(count)),
+        Ok(count) => Err(format!("--positions {count}: expected 1 to 64 points")),
+        Err(_) => Ok(PointPlan::Given(strike_points(
+            surface,
+            &parse_points(text, args.scale)?,
+        ))),
+    }
+}
+
+/// The strike points of `plan`, spread by the solid's `modes` where asked.
+fn placed_points(
+    plan: PointPlan,
+    surface: &Surface,
+    modes: &MeshModes,
+    place: &str,
+) -> Vec<StrikePoint> {
+    match plan {
+        PointPlan::Given(points) => points,
+        PointPlan::Spread(count) => {
+            let points = spread_strike_points(surface, modes, count);
+            if points.len() < count {
+                eprintln!(
+                    "{place}: only {} strike points can be spread over a surface of {} faces",
+                    points.len(),
+                    surface.triangles.len()
+                );
+            }
+            points
+        }
+    }
+}
+
+/// The recording (read) and where it was struck, for `--match REC=POINT`: one of the strike
+/// points named `names`, or a place of its own.
 fn recording_point(
     spec: &str,
     surface: &Surface,
-    points: &mut Vec<modal_resonator::model::mesh::StrikePoint>,
+    names: &[String],
     scale: f64,
-) -> Result<(Recording, usize, String), String> {
+) -> Result<(Recording, RecordedAt, String), String> {
     let (path, point) = spec
         .rsplit_once('=')
         .ok_or_else(|| format!("--match \"{spec}\": expected REC.wav=NAME or REC.wav=X,Y,Z"))?;
@@ -179,26 +265,25 @@ fn recording_point(
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    if let Some(k) = points.iter().position(|p| p.name == point.trim()) {
-        return Ok((read(&points[k].name)?, k, file_name));
+    if let Some(k) = names.iter().position(|name| name == point.trim()) {
+        return Ok((read(&names[k])?, RecordedAt::Point(k), file_name));
     }
     let stem = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "recording".to_string());
     let request = parse_points(&format!("{stem}={point}"), scale).map_err(|_| {
-        let names: Vec<&str> = points.iter().map(|p| p.name.as_str()).collect();
         format!(
             "--match \"{spec}\": \"{point}\" is neither a strike point ({}) nor X,Y,Z",
             names.join(", ")
         )
     })?;
-    if points.len() >= 64 {
+    if names.len() >= 64 {
         return Err("--match: a bank has at most 64 positions".to_string());
     }
     let recording = read(&request[0].name)?;
-    points.extend(strike_points(surface, &request));
-    Ok((recording, points.len() - 1, file_name))
+    let point = strike_points(surface, &request).remove(0);
+    Ok((recording, RecordedAt::Added(point), file_name))
 }
 
 /// `bank` combined with `recording` (of the file `file_name`), struck at position `at`.
@@ -337,11 +422,23 @@ fn material(args: &MeshArgs) -> Material {
     material
 }
 
+/// The most memory a solve may hold: [`DEFAULT_MAX_SOLVE_BYTES`], or half the machine's
+/// memory when that is less (read from `/proc/meminfo` where there is one).
+fn memory_limit_bytes() -> usize {
+    let machine = std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|text| {
+            let line = text.lines().find(|l| l.starts_with("MemTotal:"))?;
+            let kib: usize = line.split_whitespace().nth(1)?.parse().ok()?;
+            Some(kib.saturating_mul(1024))
+        });
+    machine.map_or(DEFAULT_MAX_SOLVE_BYTES, |bytes| {
+        (bytes / 2).min(DEFAULT_MAX_SOLVE_BYTES)
+    })
+}
+
 /// Solves with a progress bar for each stage.
-fn solve_with_progress(
-    surface: &Surface,
-    settings: &MeshSettings,
-) -> Result<MeshModes, modal_resonator::model::mesh::MeshError> {
+fn solve_with_progress(surface: &Surface, settings: &MeshSettings) -> Result<MeshModes, MeshError> {
     let mut bar: Option<(&'static str, Progress)> = None;
     let mut stage_bar = |label: &'static str, done: f64| {
         if bar.as_ref().is_none_or(|(l, _)| *l != label) {
@@ -354,7 +451,8 @@ fn solve_with_progress(
             progress.set(done);
         }
     };
-    let modes = solve_modes(surface, settings, &mut |stage| match stage {
+    let limit = memory_limit_bytes();
+    let modes = solve_modes_within(surface, settings, limit, &mut |stage| match stage {
         MeshStage::Voxelising => stage_bar("voxelising", 0.0),
         MeshStage::Assembling { .. } => stage_bar("assembling", 0.0),
         MeshStage::Solving(SolveStage::Factorising) => stage_bar("factorising", 0.0),
@@ -475,12 +573,14 @@ fn report(args: &MeshArgs, modes: &MeshModes, bank: &modal_resonator::model::Ban
     let say = |line: &str| say(&args.output, line);
     say(&bank.description);
     say(&format!(
-        "  {} elements of {:.3} mm, {} degrees of freedom, {} rigid motions left out; \
-         voxels {:.2} s, assembly {:.2} s, factorisation {:.2} s, {} Lanczos steps {:.2} s",
+        "  {} elements of {:.3} mm, {} degrees of freedom, {} rigid motions left out, about \
+         {:.0} MiB; voxels {:.2} s, assembly {:.2} s, factorisation {:.2} s, {} Lanczos steps \
+         {:.2} s",
         stats.elements,
         stats.voxel_m * 1e3,
         stats.dofs,
         stats.rigid_modes,
+        stats.memory_bytes as f64 / (1u64 << 20) as f64,
         stats.voxelising.as_secs_f64(),
         stats.assembling.as_secs_f64(),
         stats.factorising.as_secs_f64(),

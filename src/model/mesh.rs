@@ -5,7 +5,8 @@
 //! ([`voxel::voxelize`]), each cube an 8-node brick of linear elasticity with incompatible
 //! bending modes ([`element`]); their stiffness and mass are assembled sparse ([`assemble`]),
 //! and the lowest modes of `K phi = omega^2 M phi` come from shift-invert Lanczos on a sparse
-//! Cholesky factorisation ([`lanczos`]). Rigid motions of a free object are found and left out.
+//! Cholesky factorisation ([`lanczos`]). The rigid motions the clamps leave ([`rigid`]: six for a
+//! free object) come out first, at zero, and are left out.
 //! A mode's gain at a strike point is its mass-normalised shape along the surface normal there,
 //! over `omega` (seed 000 eq. 3.11, as the analytic shapes do); decays come from the material.
 //!
@@ -16,27 +17,30 @@
 
 pub mod assemble;
 pub mod element;
+pub mod error;
 pub mod generate;
 pub mod lanczos;
 pub mod matching;
 pub mod read;
+pub mod rigid;
+pub mod strike;
 pub mod surface;
 pub mod to_bank;
 pub mod voxel;
 
-use std::fmt;
 use std::time::{Duration, Instant};
 
+pub use error::{scale_hint, unit_warning, MeshError};
 pub use lanczos::SolveStage;
 pub use matching::{combine_with_recording, MatchReport};
 pub use read::{parse_surface, write_obj};
+pub use strike::{spread_strike_points, strike_points, StrikePoint, StrikeRequest};
 pub use surface::Surface;
-pub use to_bank::{
-    bank_from_modes, spread_strike_points, strike_points, MeshSource, StrikePoint, StrikeRequest,
-};
+pub use to_bank::{bank_from_modes, MeshSource};
 pub use voxel::Voxels;
 
 use crate::model::materials::Material;
+use crate::model::validate::MODE_FREQ_HZ;
 
 /// Default number of solid voxels: 100 modes of it solve in seconds.
 pub const DEFAULT_ELEMENTS: usize = 20_000;
@@ -44,186 +48,21 @@ pub const DEFAULT_ELEMENTS: usize = 20_000;
 /// Most modes one solve finds.
 pub const MAX_MODES: usize = 500;
 
-/// The Lanczos shift, `-(2 pi 20 Hz)^2`: below every audible mode and below the rigid motions'
-/// zero, so `K - sigma M` is positive definite.
-const SHIFT_HZ: f64 = 20.0;
+/// The Lanczos shift is `-(2 pi f)^2` with `f` this share of `c / D` (the material's rod wave
+/// speed over the bounding box's diagonal): 20 Hz for the 300 mm steel bar. Below zero, so
+/// `K - sigma M` is positive definite with the rigid motions' zeros; scaled with the object, so
+/// its conditioning is the same at any size (stiffness over mass goes as 1 / size^2) and the
+/// lowest modes of a large object (a 300 m bar's 0.57 Hz) lie well above it, apart from the
+/// zeros, as the bar's 576 Hz does above 20 Hz.
+const SHIFT_SHARE: f64 = 1.2e-3;
 
-/// Modes below this frequency are rigid motions (numerically zero), not vibrations.
-const RIGID_HZ: f64 = 1.0;
+/// A motion left out as rigid whose frequency exceeds this share of the lowest mode kept is
+/// not rigid: the clamps hold it only weakly (a pivot), and [`MeshModes::rigid_warning`] says so.
+const RIGID_SHARE: f64 = 0.01;
 
-/// Rigid motions of a free solid: three translations, three rotations.
-const RIGID_MOTIONS: usize = 6;
-
-/// Why a mesh could not be made into modes.
-#[derive(Debug, Clone, PartialEq)]
-pub enum MeshError {
-    /// The file cannot be read as a mesh.
-    Syntax {
-        /// Line (OBJ, ASCII STL) or triangle (binary STL), from 1.
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// No triangles.
-    Empty,
-    /// A face refers to a vertex that does not exist.
-    BadIndex {
-        /// Face index, from 0.
-        face: usize,
-        /// The vertex index it names.
-        vertex: usize,
-        /// Number of vertices.
-        count: usize,
-    },
-    /// A triangle without area.
-    Degenerate {
-        /// Face index.
-        face: usize,
-        /// Its vertices.
-        vertices: [u32; 3],
-    },
-    /// An edge with a triangle on one side only: the surface has a hole.
-    Open {
-        /// The face with the edge.
-        face: usize,
-        /// The edge's vertices.
-        edge: [u32; 2],
-    },
-    /// An edge shared by more than two triangles.
-    NonManifold {
-        /// The faces sharing it.
-        faces: Vec<usize>,
-        /// The edge's vertices.
-        edge: [u32; 2],
-    },
-    /// Two neighbouring triangles facing opposite ways.
-    Inconsistent {
-        /// The two faces.
-        faces: [usize; 2],
-        /// Their shared edge.
-        edge: [u32; 2],
-    },
-    /// The triangles face inward.
-    InsideOut {
-        /// The signed volume, negative.
-        volume_m3: f64,
-    },
-    /// The surface is closed but encloses (almost) nothing: it is folded flat.
-    NoVolume {
-        /// The enclosed volume.
-        volume_m3: f64,
-    },
-    /// More triangles, cells or elements than can be solved.
-    TooLarge {
-        /// What there are too many of.
-        what: &'static str,
-        /// How many.
-        count: usize,
-        /// The limit.
-        limit: usize,
-    },
-    /// No voxel centre falls inside the surface.
-    TooThin {
-        /// Voxel edge in metres.
-        voxel_m: f64,
-    },
-    /// The voxels fall apart into several pieces.
-    Pieces {
-        /// How many.
-        pieces: usize,
-        /// Voxel edge in metres.
-        voxel_m: f64,
-    },
-    /// A setting is out of range.
-    BadSetting {
-        /// Its name.
-        name: &'static str,
-        /// What was expected.
-        reason: String,
-    },
-    /// The eigensolver failed.
-    Solver(String),
-    /// No elastic mode lies below the frequency limit.
-    NoModes {
-        /// The limit in Hz.
-        max_freq_hz: f64,
-    },
-}
-
-impl fmt::Display for MeshError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Self::Syntax { line, message } => write!(f, "line {line}: {message}"),
-            Self::Empty => write!(f, "the mesh has no faces"),
-            Self::BadIndex {
-                face,
-                vertex,
-                count,
-            } => write!(
-                f,
-                "face {face} names vertex {vertex}, but there are only {count} vertices"
-            ),
-            Self::Degenerate { face, vertices } => write!(
-                f,
-                "face {face} (vertices {vertices:?}) has no area: remove degenerate triangles"
-            ),
-            Self::Open { face, edge } => write!(
-                f,
-                "the surface is not closed: edge {edge:?} of face {face} borders no other face \
-                 (a hole); a solid needs a watertight surface"
-            ),
-            Self::NonManifold { faces, edge } => write!(
-                f,
-                "the surface is not manifold: edge {edge:?} is shared by {} faces {faces:?}, \
-                 expected 2",
-                faces.len()
-            ),
-            Self::Inconsistent { faces, edge } => write!(
-                f,
-                "faces {} and {} face opposite ways across edge {edge:?}: orient every face \
-                 counter-clockwise seen from outside",
-                faces[0], faces[1]
-            ),
-            Self::InsideOut { volume_m3 } => write!(
-                f,
-                "the surface is inside-out (its faces point inward, signed volume {volume_m3:.3e} \
-                 m^3): flip the normals"
-            ),
-            Self::NoVolume { volume_m3 } => write!(
-                f,
-                "the surface encloses no volume ({volume_m3:.3e} m^3): it is folded flat, or \
-                 its units are far too small (see --scale)"
-            ),
-            Self::TooLarge { what, count, limit } => write!(
-                f,
-                "too large: {count} {what}, at most {limit}; use fewer elements or a coarser mesh"
-            ),
-            Self::TooThin { voxel_m } => write!(
-                f,
-                "no voxel of {:.3} mm fits inside the surface: the object is thinner than a voxel; \
-                 use more elements",
-                voxel_m * 1e3
-            ),
-            Self::Pieces { pieces, voxel_m } => write!(
-                f,
-                "at voxels of {:.3} mm the object falls apart into {pieces} pieces: a wall or \
-                 a joint is thinner than a voxel (or the mesh holds separate objects); use more \
-                 elements",
-                voxel_m * 1e3
-            ),
-            Self::BadSetting { name, reason } => write!(f, "{name}: {reason}"),
-            Self::Solver(reason) => write!(f, "the eigensolver failed: {reason}"),
-            Self::NoModes { max_freq_hz } => {
-                write!(
-                    f,
-                    "no mode below {max_freq_hz} Hz: the object is too small or too stiff"
-                )
-            }
-        }
-    }
-}
-
-impl std::error::Error for MeshError {}
+/// At most this many bytes may a solve hold ([`solve_modes`]): a larger one is refused before
+/// its numeric factorisation starts.
+pub const DEFAULT_MAX_SOLVE_BYTES: usize = 8 << 30;
 
 /// A region of the solid held still.
 #[derive(Debug, Clone, PartialEq)]
@@ -289,8 +128,13 @@ pub struct SolveStats {
     pub factor_entries: usize,
     /// Lanczos steps.
     pub steps: usize,
-    /// Rigid motions found and left out.
+    /// Rigid motions the clamps leave (six for a free object), left out.
     pub rigid_modes: usize,
+    /// The highest frequency among the motions left out as rigid, in Hz: near zero when they
+    /// are rigid, higher when a clamp holds the object only at a pivot.
+    pub rigid_max_hz: f64,
+    /// Bytes the solve was expected to hold at its peak.
+    pub memory_bytes: usize,
     /// Time to fill the surface with voxels.
     pub voxelising: Duration,
     /// Time to assemble the matrices.
@@ -330,10 +174,22 @@ pub struct MeshModes {
     pub stats: SolveStats,
 }
 
-/// The lowest vibration modes of the solid bounded by `surface` (checked here).
+/// The lowest vibration modes of the solid bounded by `surface` (checked here), the solve
+/// holding at most [`DEFAULT_MAX_SOLVE_BYTES`].
 pub fn solve_modes(
     surface: &Surface,
     settings: &MeshSettings,
+    progress: &mut dyn FnMut(MeshStage),
+) -> Result<MeshModes, MeshError> {
+    solve_modes_within(surface, settings, DEFAULT_MAX_SOLVE_BYTES, progress)
+}
+
+/// The lowest vibration modes of the solid bounded by `surface` (checked here); a solve that
+/// would hold more than `max_bytes` is refused before its numeric factorisation.
+pub fn solve_modes_within(
+    surface: &Surface,
+    settings: &MeshSettings,
+    max_bytes: usize,
     progress: &mut dyn FnMut(MeshStage),
 ) -> Result<MeshModes, MeshError> {
     surface.check()?;
@@ -357,6 +213,54 @@ pub fn solve_modes(
     progress(MeshStage::Assembling {
         elements: stats.elements,
     });
+    let (system, rigid) = assemble_clamped(&voxels, settings, voxel_m);
+    stats.dofs = system.dofs;
+    stats.matrix_entries = system.entries();
+    stats.rigid_modes = rigid;
+    stats.assembling = started.elapsed();
+
+    let started = Instant::now();
+    let m = &settings.material;
+    let shift_hz = SHIFT_SHARE * m.rod_wave_speed_m_per_s() / diagonal_m(&voxels);
+    let pairs = lanczos::lowest_eigenpairs(
+        &system,
+        settings.modes + rigid,
+        -(std::f64::consts::TAU * shift_hz).powi(2),
+        max_bytes,
+        &mut |stage| progress(MeshStage::Solving(stage)),
+    )?;
+    stats.factorising = pairs.factorising;
+    stats.iterating = started.elapsed().saturating_sub(pairs.factorising);
+    stats.factor_entries = pairs.factor_entries;
+    stats.memory_bytes = pairs.memory_bytes;
+    stats.steps = pairs.steps;
+
+    let (freqs_hz, shapes, rigid_max_hz) = without_rigid_motions(pairs, rigid, settings.modes)?;
+    stats.rigid_max_hz = rigid_max_hz;
+    let modes = MeshModes {
+        voxels,
+        corner_dof: system.corner_dof,
+        freqs_hz,
+        shapes,
+        stats,
+    };
+    if modes.freqs_hz[0] < MODE_FREQ_HZ.min {
+        return Err(MeshError::BelowFloor {
+            lowest_hz: modes.freqs_hz[0],
+            size_m: modes.longest_side_m(),
+        });
+    }
+    Ok(modes)
+}
+
+/// The system of `voxels` with the corners `settings.clamps` hold left out, and the number of
+/// rigid motions those clamps leave ([`rigid::rigid_motions_left`]): a plane holds the grid
+/// corners on its side, a point the corners within a voxel of it, as a pin at the point.
+fn assemble_clamped(
+    voxels: &Voxels,
+    settings: &MeshSettings,
+    voxel_m: f64,
+) -> (assemble::System, usize) {
     let m = &settings.material;
     let brick = element::brick_matrices(
         voxels.size_m,
@@ -364,35 +268,53 @@ pub fn solve_modes(
         m.youngs_modulus_pa,
         m.poisson_ratio,
     );
-    let system = assemble::assemble(&voxels, &brick, |p| {
-        settings.clamps.iter().any(|c| c.holds(p, voxel_m))
+    let mut held_m = Vec::new();
+    let mut pinned = vec![false; settings.clamps.len()];
+    let system = assemble::assemble(voxels, &brick, |p| {
+        let mut held = false;
+        for (c, clamp) in settings.clamps.iter().enumerate() {
+            if clamp.holds(p, voxel_m) {
+                held = true;
+                match clamp {
+                    Clamp::Near { .. } => pinned[c] = true,
+                    Clamp::Below { .. } | Clamp::Above { .. } => held_m.push(p),
+                }
+            }
+        }
+        held
     });
-    stats.dofs = system.dofs;
-    stats.matrix_entries = system.entries();
-    stats.assembling = started.elapsed();
+    for (clamp, _) in settings.clamps.iter().zip(&pinned).filter(|(_, &p)| p) {
+        if let Clamp::Near { point_m } = clamp {
+            held_m.push(*point_m);
+        }
+    }
+    let rigid = rigid::rigid_motions_left(&held_m, diagonal_m(voxels));
+    (system, rigid)
+}
 
-    let started = Instant::now();
-    let shift = -(std::f64::consts::TAU * SHIFT_HZ).powi(2);
-    let pairs = lanczos::lowest_eigenpairs(
-        &system,
-        settings.modes + RIGID_MOTIONS,
-        shift,
-        &mut |stage| progress(MeshStage::Solving(stage)),
-    )?;
-    stats.factorising = pairs.factorising;
-    stats.iterating = started.elapsed().saturating_sub(pairs.factorising);
-    stats.factor_entries = pairs.factor_entries;
-    stats.steps = pairs.steps;
+/// The diagonal of the voxel grid (the surface's bounding box) in metres.
+fn diagonal_m(voxels: &Voxels) -> f64 {
+    let sides = [0, 1, 2].map(|a| voxels.size_m[a] * voxels.dims[a] as f64);
+    surface::norm(sides)
+}
 
-    let (freqs_hz, shapes, rigid_modes) = without_rigid_motions(pairs, settings.modes);
-    stats.rigid_modes = rigid_modes;
-    Ok(MeshModes {
-        voxels,
-        corner_dof: system.corner_dof,
-        freqs_hz,
-        shapes,
-        stats,
-    })
+/// `Ok` when `elements` voxels may be asked for: checked before anything is read or computed,
+/// as the solve's memory grows faster than the count.
+pub fn check_elements(elements: usize) -> Result<(), MeshError> {
+    if elements < 8 {
+        return Err(MeshError::BadSetting {
+            name: "elements",
+            reason: format!("expected at least 8, found {elements}"),
+        });
+    }
+    if elements > voxel::MAX_ELEMENTS {
+        return Err(MeshError::TooLarge {
+            what: "elements",
+            count: elements,
+            limit: voxel::MAX_ELEMENTS,
+        });
+    }
+    Ok(())
 }
 
 impl MeshSettings {
@@ -404,38 +326,68 @@ impl MeshSettings {
                 reason: format!("expected 1 to {MAX_MODES}, found {}", self.modes),
             });
         }
-        if self.elements < 8 {
-            return Err(MeshError::BadSetting {
-                name: "elements",
-                reason: format!("expected at least 8, found {}", self.elements),
-            });
-        }
-        Ok(())
+        check_elements(self.elements)
     }
 }
 
-/// The first `count` vibration modes of `pairs` (frequencies in Hz and shapes) and the number of
-/// rigid motions among them, left out.
+/// The `count` vibration modes of `pairs` after its `rigid` lowest (frequencies in Hz and
+/// shapes), and the highest frequency among those left out (0 with none).
+#[allow(clippy::type_complexity)]
 fn without_rigid_motions(
     pairs: lanczos::Eigenpairs,
+    rigid: usize,
     count: usize,
-) -> (Vec<f64>, Vec<Vec<f64>>, usize) {
-    let rigid_limit = (std::f64::consts::TAU * RIGID_HZ).powi(2);
-    let mut freqs_hz = Vec::new();
-    let mut shapes = Vec::new();
-    let mut rigid = 0;
-    for (value, vector) in pairs.values.into_iter().zip(pairs.vectors) {
-        if value < rigid_limit {
-            rigid += 1;
-        } else if freqs_hz.len() < count {
-            freqs_hz.push(value.sqrt() / std::f64::consts::TAU);
-            shapes.push(vector);
-        }
+) -> Result<(Vec<f64>, Vec<Vec<f64>>, f64), MeshError> {
+    let to_hz = |value: f64| value.max(0.0).sqrt() / std::f64::consts::TAU;
+    if pairs.values.len() <= rigid {
+        return Err(MeshError::Solver(format!(
+            "{} eigenpairs found, none beyond the {rigid} rigid motions",
+            pairs.values.len()
+        )));
     }
-    (freqs_hz, shapes, rigid)
+    let rigid_max_hz = pairs.values[..rigid]
+        .iter()
+        .copied()
+        .map(to_hz)
+        .fold(0.0, f64::max);
+    let freqs_hz = pairs.values[rigid..]
+        .iter()
+        .take(count)
+        .copied()
+        .map(to_hz)
+        .collect();
+    let shapes = pairs.vectors.into_iter().skip(rigid).take(count).collect();
+    Ok((freqs_hz, shapes, rigid_max_hz))
 }
 
 impl MeshModes {
+    /// The longest side of the voxel grid (the surface's bounding box) in metres.
+    pub fn longest_side_m(&self) -> f64 {
+        let v = &self.voxels;
+        (0..3)
+            .map(|a| v.size_m[a] * v.dims[a] as f64)
+            .fold(0.0, f64::max)
+    }
+
+    /// A warning when the motions left out as rigid are not near zero (above 1 % of the lowest
+    /// mode kept): what holds the object does so only at a pivot, whose motions about it ring at
+    /// a low but real frequency.
+    pub fn rigid_warning(&self) -> Option<String> {
+        let s = &self.stats;
+        let lowest = self.freqs_hz.first().copied().unwrap_or(0.0);
+        (s.rigid_modes > 0 && s.rigid_max_hz > RIGID_SHARE * lowest).then(|| {
+            format!(
+                "the {} motions left out as rigid reach {:.2} Hz, more than {:.0} % of the lowest \
+                 mode kept ({lowest:.2} Hz): they are not rigid; an object held only at a point \
+                 or along a line turns about it at such a frequency (hold a patch: a plane, or \
+                 vertices not on one line)",
+                s.rigid_modes,
+                s.rigid_max_hz,
+                100.0 * RIGID_SHARE
+            )
+        })
+    }
+
     /// Each mode's displacement at `point_m` (on or near the solid) along the unit vector
     /// `direction`, from the voxel nearest the point (trilinear between its corners).
     pub fn displacement_along(&self, point_m: [f64; 3], direction: [f64; 3]) -> Vec<f64> {

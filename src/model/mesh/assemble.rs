@@ -53,7 +53,7 @@ impl System {
 pub fn assemble(
     voxels: &Voxels,
     brick: &BrickMatrices,
-    clamped: impl Fn([f64; 3]) -> bool,
+    clamped: impl FnMut([f64; 3]) -> bool,
 ) -> System {
     let (corner_dof, dofs) = number_corners(voxels, clamped);
     let entries = brick_entries(voxels, brick, &corner_dof);
@@ -77,7 +77,7 @@ fn corner_index(dims: [usize; 3], i: usize, j: usize, k: usize) -> usize {
 /// count.
 fn number_corners(
     voxels: &Voxels,
-    clamped: impl Fn([f64; 3]) -> bool,
+    mut clamped: impl FnMut([f64; 3]) -> bool,
 ) -> (Vec<Option<usize>>, usize) {
     let [nx, ny, nz] = voxels.dims;
     let (cx, cy) = (nx + 1, ny + 1);

@@ -7,10 +7,10 @@
 //! With a shift below zero, `K - sigma M` is positive definite even for a free object, whose six
 //! rigid motions (`lambda = 0`) come out first and are left out by the caller.
 
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::Llt;
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::{factorize_symbolic_cholesky, LltRef, SymbolicCholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{ColRef, MatRef, Side};
+use faer::{ColRef, Conj, MatMut, MatRef, Side};
 
 use super::assemble::System;
 use super::MeshError;
@@ -56,16 +56,20 @@ pub struct Eigenpairs {
     pub steps: usize,
     /// Non-zero entries of the Cholesky factor.
     pub factor_entries: usize,
+    /// Bytes the solve was expected to hold at its peak (see `solve_bytes`).
+    pub memory_bytes: usize,
     /// Time spent factorising.
     pub factorising: std::time::Duration,
 }
 
 /// The `count` lowest eigenpairs of `system` above `shift` (in (rad/s)^2; below every eigenvalue
-/// wanted, and below zero for a free object).
+/// wanted, and below zero for a free object), refused before the numeric factorisation when the
+/// solve would hold more than `max_bytes`.
 pub fn lowest_eigenpairs(
     system: &System,
     count: usize,
     shift: f64,
+    max_bytes: usize,
     progress: &mut dyn FnMut(SolveStage),
 ) -> Result<Eigenpairs, MeshError> {
     let n = system.dofs;
@@ -88,14 +92,23 @@ pub fn lowest_eigenpairs(
     }
     progress(SolveStage::Factorising);
     let started = std::time::Instant::now();
-    let (factor, factor_entries) = factorise(system, shift)?;
+    let symbolic = analyse(system)?;
+    let memory_bytes = solve_bytes(system, &symbolic, count, max_steps);
+    if memory_bytes > max_bytes {
+        return Err(MeshError::TooMuchMemory {
+            needed_bytes: memory_bytes,
+            limit_bytes: max_bytes,
+        });
+    }
+    let mut factor = Factor::new(system, symbolic, shift)?;
+    let factor_entries = factor.values.len();
     let factorising = started.elapsed();
 
     let mut expected = (2 * count + EXTRA_STEPS).min(max_steps);
     let mut next_check = expected.min(count + EXTRA_STEPS);
-    let mut lanczos = Lanczos::new(system, expected);
+    let mut lanczos = Lanczos::new(system, max_steps);
     loop {
-        lanczos.step(system, &factor);
+        lanczos.step(system, &mut factor);
         let steps = lanczos.alpha.len();
         progress(SolveStage::Iterating { steps, expected });
         if steps >= next_check || steps == max_steps {
@@ -106,6 +119,7 @@ pub fn lowest_eigenpairs(
                     vectors: ritz_vectors(&lanczos.basis, n, &ritz),
                     steps,
                     factor_entries,
+                    memory_bytes,
                     factorising,
                 });
             }
@@ -115,32 +129,109 @@ pub fn lowest_eigenpairs(
     }
 }
 
-/// The Cholesky factor of `K - shift M` and its number of entries.
-fn factorise(system: &System, shift: f64) -> Result<(Llt<usize, f64>, usize), MeshError> {
+/// The symbolic Cholesky factorisation of the system's pattern (fill-reducing ordering and the
+/// factor's structure): what the numeric factorisation will need is known from it.
+fn analyse(system: &System) -> Result<SymbolicCholesky<usize>, MeshError> {
     let n = system.dofs;
-    let shifted: Vec<f64> = system
-        .stiffness
-        .iter()
-        .zip(&system.mass)
-        .map(|(k, m)| k - shift * m)
-        .collect();
-    let symbolic = SymbolicSparseColMatRef::new_checked(n, n, &system.col_ptr, None, &system.rows);
-    let matrix = SparseColMatRef::new(symbolic, &shifted);
-    let factor = matrix.sp_cholesky(Side::Lower).map_err(|e| {
-        MeshError::Solver(format!(
-            "K - sigma M is not positive definite ({e:?}): the mesh may hold a mechanism"
-        ))
-    })?;
-    // The factor's size, for the report (the symbolic analysis again: the solver keeps its own).
-    let entries = faer::sparse::linalg::cholesky::factorize_symbolic_cholesky(
-        symbolic,
-        Side::Lower,
-        Default::default(),
-        Default::default(),
-    )
-    .map(|s| s.len_val())
-    .unwrap_or(0);
-    Ok((factor, entries))
+    let pattern = SymbolicSparseColMatRef::new_checked(n, n, &system.col_ptr, None, &system.rows);
+    factorize_symbolic_cholesky(pattern, Side::Lower, Default::default(), Default::default())
+        .map_err(|e| MeshError::Solver(format!("the factor's structure: {e:?}")))
+}
+
+/// Bytes the solve holds at its peak: the system, the factor's values, and the larger of the
+/// factorisation's own (the shifted matrix and faer's workspace) and the Lanczos iteration's
+/// (a basis of `max_steps` vectors, `count` Ritz vectors, the tridiagonal matrix and its
+/// eigenvectors). The voxels and the surface, held before, are left out: a few bytes per cell.
+fn solve_bytes(
+    system: &System,
+    symbolic: &SymbolicCholesky<usize>,
+    count: usize,
+    max_steps: usize,
+) -> usize {
+    const F64: usize = std::mem::size_of::<f64>();
+    let n = system.dofs;
+    // K, M and the row indices per entry; column starts; each corner's degree of freedom.
+    let held = system.entries() * 3 * F64 + (n + 1) * F64 + system.corner_dof.len() * 2 * F64;
+    let factor = symbolic.len_val() * F64;
+    let par = faer::get_global_parallelism();
+    let factorising = system.entries() * F64
+        + symbolic
+            .factorize_numeric_llt_scratch::<f64>(par, Default::default())
+            .unaligned_bytes_required();
+    // The basis, the Ritz vectors, a few working vectors, and three m x m matrices (the
+    // tridiagonal matrix, its eigenvectors and the eigensolver's workspace).
+    let iterating = (max_steps + count + 8) * n * F64 + 3 * max_steps * max_steps * F64;
+    held + factor + factorising.max(iterating)
+}
+
+/// The Cholesky factor of `K - sigma M`, with the workspace of a solve.
+struct Factor {
+    /// The structure, from [`analyse`].
+    symbolic: SymbolicCholesky<usize>,
+    /// The factor's entries.
+    values: Vec<f64>,
+    /// Workspace of one solve, kept between solves.
+    scratch: MemBuffer,
+}
+
+impl Factor {
+    /// Factorises `K - shift M` of `system` on the structure `symbolic`.
+    fn new(
+        system: &System,
+        symbolic: SymbolicCholesky<usize>,
+        shift: f64,
+    ) -> Result<Self, MeshError> {
+        let n = system.dofs;
+        let shifted: Vec<f64> = system
+            .stiffness
+            .iter()
+            .zip(&system.mass)
+            .map(|(k, m)| k - shift * m)
+            .collect();
+        let pattern =
+            SymbolicSparseColMatRef::new_checked(n, n, &system.col_ptr, None, &system.rows);
+        let matrix = SparseColMatRef::new(pattern, &shifted);
+        let par = faer::get_global_parallelism();
+        let mut values = vec![0.0; symbolic.len_val()];
+        let mut work =
+            MemBuffer::new(symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()));
+        symbolic
+            .factorize_numeric_llt(
+                &mut values,
+                matrix,
+                Side::Lower,
+                Default::default(),
+                par,
+                MemStack::new(&mut work),
+                Default::default(),
+            )
+            .map_err(|e| {
+                // With a shift below zero K - sigma M is positive definite in exact arithmetic
+                // (K is semi-definite, M definite): only rounding can break it.
+                MeshError::Solver(format!(
+                    "K - sigma M lost positive definiteness to rounding ({e:?}): the object's \
+                     stiffest and softest motions lie too far apart for double precision (a \
+                     wall far thinner than the object is large, or materials far apart)"
+                ))
+            })?;
+        let scratch = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, par));
+        Ok(Self {
+            symbolic,
+            values,
+            scratch,
+        })
+    }
+
+    /// `x = (K - sigma M)^-1 x`.
+    fn solve_in_place(&mut self, x: &mut [f64]) {
+        let n = x.len();
+        LltRef::new(&self.symbolic, &self.values).solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(x, n, 1),
+            faer::get_global_parallelism(),
+            MemStack::new(&mut self.scratch),
+        );
+    }
 }
 
 /// The Lanczos recurrence's state: the basis so far, the tridiagonal matrix's diagonal and
@@ -163,8 +254,9 @@ struct Lanczos {
 }
 
 impl Lanczos {
-    /// A recurrence from a pseudo-random start, with room for `expected` steps.
-    fn new(system: &System, expected: usize) -> Self {
+    /// A recurrence from a pseudo-random start, with room for `max_steps` steps (reserved, not
+    /// touched: the basis never moves, so it never holds two copies of itself).
+    fn new(system: &System, max_steps: usize) -> Self {
         let n = system.dofs;
         let mut seed = 0x9e37_79b9_7f4a_7c15u64;
         let w = random_vector(n, &mut seed);
@@ -172,7 +264,7 @@ impl Lanczos {
         system.mass_times(&w, &mut mw);
         Self {
             n,
-            basis: Vec::with_capacity(n * expected),
+            basis: Vec::with_capacity(n * max_steps),
             alpha: Vec::new(),
             beta: Vec::new(),
             w,
@@ -185,7 +277,7 @@ impl Lanczos {
     /// the basis if the last step broke down, `w` then lying in an invariant subspace), then
     /// `w = (K - sigma M)^-1 M q`, its component along `q` (alpha) and its norm once
     /// orthogonal to the whole basis (beta).
-    fn step(&mut self, system: &System, factor: &Llt<usize, f64>) {
+    fn step(&mut self, system: &System, factor: &mut Factor) {
         let n = self.n;
         let mut b = m_norm(&self.w, &self.mw);
         let scale = self.alpha.iter().fold(0.0f64, |s, a| s.max(a.abs()));
@@ -198,7 +290,7 @@ impl Lanczos {
         let mq: Vec<f64> = self.mw.iter().map(|x| x / b).collect();
         self.basis.extend(self.w.iter().map(|x| x / b));
         self.w.copy_from_slice(&mq);
-        factor.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut self.w, n, 1));
+        factor.solve_in_place(&mut self.w);
         self.alpha
             .push(mq.iter().zip(&self.w).map(|(m, w)| m * w).sum());
         orthogonalise(&self.basis, n, system, &mut self.w, &mut self.mw);

@@ -21,6 +21,11 @@ const PAIR_TOLERANCE: f64 = 0.03;
 /// A mesh mode is excited at a point when its gain there is within this many dB of its largest.
 const EXCITED_DB: f64 = -30.0;
 
+/// A mesh mode whose gains all lie below this (-120 dB of a meshed bank's largest gain, which
+/// is 1) is silent at the bank's points: a bar's twisting modes on its centre line, where the
+/// solver's rounding leaves gains of 1e-9 whose relative sizes mean nothing.
+const SILENT_GAIN: f64 = 1e-6;
+
 /// A pair whose log frequency ratio lies farther than this from the fitted line is a chance
 /// pairing (about 1 %).
 const LINE_OUTLIER: f64 = 0.01;
@@ -53,9 +58,11 @@ fn largest(mode: &Mode) -> f64 {
     mode.gains.iter().fold(0.0f64, |a, g| a.max(g.abs()))
 }
 
-/// Whether mesh mode `mode` is excited at position `at`.
+/// Whether mesh mode `mode` is excited at position `at`: not when it is silent at every point
+/// (its gains, at most [`SILENT_GAIN`] of the bank's largest, are rounding, not motion).
 fn excited(mode: &Mode, at: usize) -> bool {
-    mode.gains[at].abs() >= largest(mode) * 10f64.powf(EXCITED_DB / 20.0) && largest(mode) > 0.0
+    mode.gains[at].abs() >= largest(mode) * 10f64.powf(EXCITED_DB / 20.0)
+        && largest(mode) > SILENT_GAIN
 }
 
 /// The scale `recorded / mesh` under which the most recorded strength finds a mesh mode.

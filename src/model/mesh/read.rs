@@ -14,10 +14,14 @@ pub fn parse_surface(name: &str, bytes: &[u8]) -> Result<Surface, MeshError> {
         || (!lower.ends_with(".obj") && (bytes.starts_with(b"solid") || is_binary_stl(bytes)));
     if stl {
         if is_binary_stl(bytes) {
-            parse_binary_stl(bytes)
-        } else {
-            parse_ascii_stl(text(bytes)?)
+            return parse_binary_stl(bytes);
         }
+        // Text holds no NUL; a binary STL's header and counts almost always do.
+        let binary = bytes.contains(&0) || std::str::from_utf8(bytes).is_err();
+        if let Some(error) = binary.then(|| binary_stl_size(bytes)).flatten() {
+            return Err(error);
+        }
+        parse_ascii_stl(text(bytes)?)
     } else {
         parse_obj(text(bytes)?)
     }
@@ -34,13 +38,64 @@ fn text(bytes: &[u8]) -> Result<&str, MeshError> {
     })
 }
 
+/// What is wrong with `bytes`, neither text nor a binary STL of the size its header gives
+/// (too short, as a copy or download cut off leaves it, or too long); `None` when they look like
+/// an ASCII STL (`solid` and a `facet` at the start) with a stray byte that is not UTF-8.
+fn binary_stl_size(bytes: &[u8]) -> Option<MeshError> {
+    let start = &bytes[..bytes.len().min(512)];
+    if start.starts_with(b"solid") && start.windows(5).any(|w| w == b"facet") {
+        return None;
+    }
+    let count = (bytes.len() >= BINARY_STL_HEADER)
+        .then(|| u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize);
+    Some(MeshError::BinarySize {
+        triangles: count,
+        expected_bytes: BINARY_STL_HEADER + BINARY_STL_TRIANGLE * count.unwrap_or(0),
+        found_bytes: bytes.len(),
+    })
+}
+
+/// What [`MeshError::BinarySize`] says: a file of `found_bytes`, where a binary STL of the
+/// `triangles` its header gives (`None`: too short for a header) takes `expected_bytes`.
+pub(super) fn binary_size_message(
+    triangles: Option<usize>,
+    expected_bytes: usize,
+    found_bytes: usize,
+) -> String {
+    let Some(count) = triangles else {
+        return format!(
+            "not text, and {found_bytes} bytes are too few for a binary STL, whose header alone \
+             takes {expected_bytes}: the file is truncated"
+        );
+    };
+    let given = format!(
+        "a binary STL whose header gives {count} triangles ({expected_bytes} bytes) but the file \
+         has {found_bytes} bytes"
+    );
+    if found_bytes < expected_bytes {
+        let whole = found_bytes.saturating_sub(BINARY_STL_HEADER) / BINARY_STL_TRIANGLE;
+        format!("{given} ({whole} whole triangles): it is truncated")
+    } else {
+        format!(
+            "{given}, {} more: its count or its end is damaged",
+            found_bytes - expected_bytes
+        )
+    }
+}
+
+/// Bytes of a binary STL's header: 80 free bytes and the triangle count.
+pub(super) const BINARY_STL_HEADER: usize = 84;
+
+/// Bytes of each triangle of a binary STL: a normal, three corners and an attribute.
+pub(super) const BINARY_STL_TRIANGLE: usize = 50;
+
 /// Whether `bytes` are a binary STL: an 80-byte header, a triangle count, and 50 bytes for each.
 fn is_binary_stl(bytes: &[u8]) -> bool {
-    if bytes.len() < 84 {
+    if bytes.len() < BINARY_STL_HEADER {
         return false;
     }
     let count = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
-    bytes.len() == 84 + 50 * count
+    bytes.len() == BINARY_STL_HEADER + BINARY_STL_TRIANGLE * count
 }
 
 /// A number parsed from `word` on line `line`.
@@ -157,7 +212,7 @@ fn parse_ascii_stl(text: &str) -> Result<Surface, MeshError> {
 /// A binary STL: per triangle a normal (ignored), three corners as little-endian f32, and two
 /// attribute bytes.
 fn parse_binary_stl(bytes: &[u8]) -> Result<Surface, MeshError> {
-    let count = (bytes.len() - 84) / 50;
+    let count = (bytes.len() - BINARY_STL_HEADER) / BINARY_STL_TRIANGLE;
     if count > super::surface::MAX_TRIANGLES {
         return Err(MeshError::TooLarge {
             what: "triangles",
@@ -167,7 +222,8 @@ fn parse_binary_stl(bytes: &[u8]) -> Result<Surface, MeshError> {
     }
     let mut welder = Welder::default();
     for t in 0..count {
-        let record = &bytes[84 + 50 * t..84 + 50 * (t + 1)];
+        let at = BINARY_STL_HEADER + BINARY_STL_TRIANGLE * t;
+        let record = &bytes[at..at + BINARY_STL_TRIANGLE];
         let value = |k: usize| {
             let at = 12 + 4 * k;
             f32::from_le_bytes([record[at], record[at + 1], record[at + 2], record[at + 3]]) as f64

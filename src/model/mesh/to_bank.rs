@@ -3,7 +3,7 @@
 
 use serde_json::{json, Map, Value};
 
-use super::surface::{norm, sub, Surface};
+use super::strike::StrikePoint;
 use super::{MeshError, MeshModes, MeshSettings};
 use crate::model::materials::AIR_DAMPING_PER_S;
 use crate::model::shapes::{finish_modes, solid_contact_ms, ModeLimits, ShapeError, ShapedMode};
@@ -12,85 +12,10 @@ use crate::model::{Bank, BankDefaults, Position};
 /// Strike points are stored to the micrometre: this many steps per metre.
 const COORD_STEPS_PER_M: f64 = 1e6;
 
-/// At most this many points are candidates when spreading strike points over a surface.
-const MAX_CANDIDATES: usize = 20_000;
-
-/// A strike point as asked for: a name and a place near the surface, in metres.
-#[derive(Debug, Clone, PartialEq)]
-pub struct StrikeRequest {
-    /// Display name, e.g. "rim".
-    pub name: String,
-    /// Where, in metres (moved onto the nearest point of the surface).
-    pub point_m: [f64; 3],
-}
-
-/// A strike point on the surface.
-#[derive(Debug, Clone, PartialEq)]
-pub struct StrikePoint {
-    /// Display name.
-    pub name: String,
-    /// The point of the surface, in metres.
-    pub point_m: [f64; 3],
-    /// The surface's outward unit normal there: the direction of the strike's impulse.
-    pub normal: [f64; 3],
-}
-
-/// `requests` moved onto the surface.
-pub fn strike_points(surface: &Surface, requests: &[StrikeRequest]) -> Vec<StrikePoint> {
-    requests
-        .iter()
-        .map(|r| {
-            let (point_m, normal) = surface.nearest(r.point_m);
-            StrikePoint {
-                name: r.name.clone(),
-                point_m,
-                normal,
-            }
-        })
-        .collect()
-}
-
-/// `count` strike points spread over the surface: the first the farthest from its centre (a
-/// rim, a tip, an end: where objects are usually struck), each next the farthest from those
-/// already chosen. Named `p1`, `p2`, ...
-pub fn spread_strike_points(surface: &Surface, count: usize) -> Vec<StrikePoint> {
-    let stride = surface.triangles.len().div_ceil(MAX_CANDIDATES).max(1);
-    let candidates: Vec<[f64; 3]> = (0..surface.triangles.len())
-        .step_by(stride)
-        .map(|t| {
-            let [a, b, c] = surface.corners(t);
-            [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0)
-        })
-        .collect();
-    let (lo, hi) = surface.bounds();
-    let centre = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
-    let mut nearest_chosen: Vec<f64> = candidates.iter().map(|&p| norm(sub(p, centre))).collect();
-    let mut requests = Vec::new();
-    for k in 0..count.min(candidates.len()) {
-        let (best, _) =
-            nearest_chosen
-                .iter()
-                .enumerate()
-                .fold((0, f64::NEG_INFINITY), |(bi, bd), (i, &d)| {
-                    if d > bd {
-                        (i, d)
-                    } else {
-                        (bi, bd)
-                    }
-                });
-        let chosen = candidates[best];
-        requests.push(StrikeRequest {
-            name: format!("p{}", k + 1),
-            point_m: chosen,
-        });
-        let first = k == 0;
-        for (d, &p) in nearest_chosen.iter_mut().zip(&candidates) {
-            let to_chosen = norm(sub(p, chosen));
-            *d = if first { to_chosen } else { d.min(to_chosen) };
-        }
-    }
-    strike_points(surface, &requests)
-}
+/// The bank's root is the lowest mode its default strike (the first point) excites within
+/// this many dB of the strike's strongest mode, as [`Bank::effective_root_hz`] judges a bank's
+/// modes over all its positions.
+const ROOT_WITHIN_DB: f64 = 6.0;
 
 /// What a meshed bank records of how it was made.
 #[derive(Debug, Clone, PartialEq)]
@@ -134,7 +59,15 @@ pub fn bank_from_modes(
         .collect();
     let material = &settings.material;
     let bank_modes = finish_modes(shaped, material, limits).map_err(|e| match e {
-        ShapeError::NoModes { max_freq_hz } => MeshError::NoModes { max_freq_hz },
+        ShapeError::NoModes { max_freq_hz } => MeshError::NoModes {
+            max_freq_hz,
+            lowest_hz: modes.freqs_hz[0],
+            size_m: modes.longest_side_m(),
+        },
+        ShapeError::BelowFloor { lowest_hz, .. } => MeshError::BelowFloor {
+            lowest_hz,
+            size_m: modes.longest_side_m(),
+        },
         other => MeshError::BadSetting {
             name: "mesh",
             reason: other.to_string(),
@@ -161,13 +94,27 @@ pub fn bank_from_modes(
     bank.author = "Modal Resonator".to_string();
     bank.license = "CC0-1.0".to_string();
     bank.modes = bank_modes;
-    bank.root_hz = Some(bank.effective_root_hz());
+    bank.root_hz = Some(default_strike_root_hz(&bank));
     bank.source = Some(source_record(modes, settings, source));
     bank.defaults = Some(BankDefaults {
         hardness_ms: Some(solid_contact_ms(material.class)),
         ..BankDefaults::default()
     });
     Ok(bank)
+}
+
+/// The lowest mode the bank's first position excites within [`ROOT_WITHIN_DB`] of its
+/// strongest there: the pitch its default strike sounds.
+fn default_strike_root_hz(bank: &Bank) -> f64 {
+    let at_first = |m: &crate::model::Mode| m.gains.first().map_or(0.0, |g| g.abs());
+    let strongest = bank.modes.iter().map(at_first).fold(0.0, f64::max);
+    let floor = strongest * 10f64.powf(-ROOT_WITHIN_DB / 20.0);
+    bank.modes
+        .iter()
+        .filter(|m| strongest > 0.0 && at_first(m) >= floor)
+        .map(|m| m.freq_hz)
+        .reduce(f64::min)
+        .unwrap_or_else(|| bank.effective_root_hz())
 }
 
 /// The bank's `source`: the mesh, the material, the solver and the element counts.
