@@ -15,7 +15,10 @@
 //! - **Scrape**: the profile seen through the contact (a low-pass whose corner is the speed over
 //!   the width of the contact: a hard, sharp scraper feels finer detail), its rate of change
 //!   driving the object: the contact point's vertical velocity, `v dh/dx`, scaled by the normal
-//!   force. Faster is louder as well as brighter.
+//!   force. Faster is louder as well as brighter. The hand pressing the scraper on the object also
+//!   damps it ([`ContactKind::damping_per_s`]): without that, a held scrape on a long-ringing
+//!   object would fill its slowest modes over many seconds and wander with them, as narrow-band
+//!   noise does.
 //! - **Roll** (seed 004 section 5.3): the same ground profile low-passed by the contact patch of a
 //!   rolling object of radius `r` (a wider patch, `sqrt(2 r d)` for an indentation `d`, smooths
 //!   more, so a large ball rolls duller), plus the object's own bumps: eight per revolution, at a
@@ -75,9 +78,20 @@ const BUMP_WIDTH: f64 = 0.25;
 const GROUND_GAIN: f32 = 0.4;
 
 /// Force of a rolling object's tallest bump, relative: held, the factory table rolled on at
-/// 0.6 m/s peaks at -9.6 dBFS, the factory steel sheet scraped at 0.4 m/s at -6.1 dBFS
-/// (`tests/factory_presets.rs`).
+/// 0.6 m/s peaks at -11.4 dBFS over seconds 2 to 4, the factory steel sheet scraped at 0.4 m/s at
+/// -8.5 dBFS (`tests/factory_presets.rs`).
 const BUMP_GAIN: f32 = 16.0;
+
+/// Decay rate a held scrape adds to every mode of the object, 1/s. The scraper is held by a
+/// hand, a lossy mass coupled to the object through a stiff contact: a resistance `R` at a point
+/// adds `R phi^2 / (2 M)` to the decay of a mode of modal mass `M` and shape `phi` there
+/// (Rayleigh's dissipation function), and about 10 N s/m for a hand-held tool against the half
+/// kilogram a mode of a 0.5 x 0.35 m, 1.5 mm steel sheet moves (`rho h S / 4`) gives several per
+/// second. How hard the scraper presses changes the contact's stiffness, not the hand's loss, so
+/// the level stays in proportion to the force. Without it the factory steel sheet's lowest mode
+/// (0.28 /s, T60 25 s) took nearly all of a held scrape and filled over seconds: -6.1 dBFS after
+/// 1 s, +1.3 after 10 s, +3.8 after 300 s.
+const SCRAPE_DAMPING_PER_S: f64 = 3.0;
 
 /// The vertical velocity is in units of the profile's RMS per lowest-octave cell crossed at this
 /// speed, metres per second.
@@ -131,6 +145,19 @@ pub enum ContactKind {
     },
     /// Rubbing it: stick-slip friction (its force from [`Contact::rub`], not [`Contact::render`]).
     Rub,
+}
+
+impl ContactKind {
+    /// Decay rate, 1/s, this contact adds to every mode of the object it touches while held: a
+    /// scraper's hand damps the object ([`SCRAPE_DAMPING_PER_S`]). A rolling ball is held on by
+    /// its weight alone, through a contact close to elastic (Hertz), and a rub's loss is its
+    /// friction's own.
+    pub fn damping_per_s(self) -> f64 {
+        match self {
+            ContactKind::Scrape { .. } => SCRAPE_DAMPING_PER_S,
+            ContactKind::Roll { .. } | ContactKind::Rub => 0.0,
+        }
+    }
 }
 
 /// The contact force of one object on one surface.
