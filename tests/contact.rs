@@ -385,6 +385,50 @@ fn a_rubbed_glass_sings_at_its_clearest_mode_while_held_and_rings_on_after() {
 }
 
 #[test]
+fn a_rub_sings_louder_the_faster_it_goes_across_the_speed_range() {
+    use modal_resonator::model::factory::factory_bank;
+    use modal_resonator::units::{gain_to_db, hz_to_midi_key};
+    // The factory glass and bowl at their own force, rubbed from rest at speeds across the
+    // contact range (0 to 3 m/s): each sings on its lowest mode, louder the faster, and the fastest
+    // does not clip.
+    for slug in ["rubbed-wine-glass", "singing-bowl-circled-with-a-stick"] {
+        let bank = factory_bank(slug).expect(slug);
+        let root = bank.effective_root_hz();
+        let key = hz_to_midi_key(root).round() as u8;
+        let mut last_db = f64::NEG_INFINITY;
+        for speed in [0.1f32, 0.4, 1.0, 2.0, 3.0] {
+            let mut e = engine(&bank, RATE);
+            let mut c = e.controls().clone();
+            c.contact_speed_m_per_s = speed;
+            e.set_controls(&c);
+            let (l, r) = render(&mut e, &[on(0, key, 1.0)], 5.0, 512);
+            let held = span(&l, 4.0, 5.0);
+            let db = level_db(held);
+            let peak_db = gain_to_db(peak(&l).max(peak(&r))) as f64;
+            let hz = spectral_peak_hz(held, RATE as f64, 0.8 * root, 1.25 * root);
+            let cents = 1200.0 * (hz / root).log2();
+            println!(
+                "{slug} at {speed} m/s: {db:.1} dB RMS, peak {peak_db:.1} dBFS, {cents:+.1} cents"
+            );
+            assert!(db > -45.0, "{slug} silent at {speed} m/s: {db:.1} dB");
+            assert!(
+                cents.abs() < 25.0,
+                "{slug} at {speed} m/s sings at {hz:.1} Hz"
+            );
+            assert!(
+                db > last_db + 2.0,
+                "{slug} at {speed} m/s: {db:.1} dB, not louder than {last_db:.1} dB"
+            );
+            assert!(
+                peak_db < -1.0,
+                "{slug} at {speed} m/s peaks at {peak_db:.1} dBFS"
+            );
+            last_db = db;
+        }
+    }
+}
+
+#[test]
 fn polyphonic_modulation_sets_one_contact_notes_speed_and_force() {
     use modal_resonator::engine::VoiceModulation;
     let bank = dense_bank(300, 110.0);
