@@ -15,7 +15,10 @@
 //! - **Scrape**: the profile seen through the contact (a low-pass whose corner is the speed over
 //!   the width of the contact: a hard, sharp scraper feels finer detail), its rate of change
 //!   driving the object: the contact point's vertical velocity, `v dh/dx`, scaled by the normal
-//!   force. Faster is louder as well as brighter.
+//!   force. Faster is louder as well as brighter. The hand pressing the scraper on the object also
+//!   damps it ([`ContactKind::damping_per_s`]): without that, a held scrape on a long-ringing
+//!   object would fill its slowest modes over many seconds and wander with them, as narrow-band
+//!   noise does.
 //! - **Roll** (seed 004 section 5.3): the same ground profile low-passed by the contact patch of a
 //!   rolling object of radius `r` (a wider patch, `sqrt(2 r d)` for an indentation `d`, smooths
 //!   more, so a large ball rolls duller), plus the object's own bumps: eight per revolution, at a
@@ -26,17 +29,31 @@
 //!   bar (bowed-bar style, after McIntyre, Schumacher and Woodhouse's friction-driven
 //!   oscillators): the force is the normal force times a friction coefficient that depends on
 //!   the *relative* velocity `dv` of rubber and object at the contact point,
-//!   `mu(dv) = tanh(K dv / v0) (mu_d + (mu_s - mu_d) / (1 + |dv| / v0))`: the object sticks
-//!   while `dv` is small and slides with friction falling as `dv` grows. Where it slides, that
-//!   falling friction feeds energy into the modes moving with the rubber (negative damping);
-//!   a mode whose loss is smaller than that gain grows until it sticks and slips once a cycle, and
-//!   then sings steadily at its own frequency: a wine glass or a singing bowl. Below a force
-//!   threshold no mode gains more than it loses, and the object stays silent. The object's
-//!   velocity at the contact point is the sum of its modes' velocities (see
+//!   `mu(dv) = tanh(dv / v_s) (mu_s - c ln(1 + |dv| / v0))`: the object sticks while `dv` is
+//!   within `v_s` and slides with friction falling with the logarithm of `dv`, the velocity
+//!   weakening of Dieterich and Ruina's rate-and-state friction, from `mu_s` to `mu_d` at the
+//!   fastest rub ([`rub_friction`]). Where it slides, that falling friction feeds energy into the
+//!   modes moving with the rubber (negative damping); a mode whose loss is smaller than that gain
+//!   grows until it sticks and slips once a cycle, and then sings steadily at its own frequency,
+//!   its contact point swinging at about the rubbing speed: a wine glass or a singing bowl, louder
+//!   the faster it is rubbed. Below a force threshold no mode gains more than it loses, and the
+//!   object stays silent. The friction's slope falls as `1 / dv` (a hyperbolic curve's falls as
+//!   `1 / dv^2`), so the force a song needs rises about in proportion to its speed, as
+//!   Schelleng's minimum bow force does: a firm touch sings across the whole speed range.
+//!
+//!   The rubber's speed changes at most [`RUB_MAX_ACCELERATION_M_PER_S2`], as a hand's does: a
+//!   song catches only where the friction falls steeply, while the stroke is slow, and once caught
+//!   it rides up with the speed (a bow's attack needs its acceleration bounded by its force too:
+//!   Guettler, *On the creation of the Helmholtz motion in bowed strings*, Acta Acustica 2002).
+//!   Brought up to speed within 5 ms, as the other contacts are, the factory glass never caught
+//!   above 0.45 m/s.
+//!
+//!   The object's velocity at the contact point is the sum of its modes' velocities (see
 //!   [`crate::dsp::resonator_bank::ResonatorBank::process_rubbed`]), one sample old, so the
-//!   friction is computed explicitly; the stick stiffness is set so that this one-sample loop
-//!   gains at most [`RUB_LOOP_GAIN`] per sample whatever the bank. The force is high-passed at
-//!   [`RUB_DC_HZ`], so the steady drag does not push the object off its rest position.
+//!   friction is computed explicitly; the sticking branch is made wide enough that this
+//!   one-sample loop gains at most [`RUB_LOOP_GAIN`] per sample whatever the bank. The force is
+//!   high-passed at [`RUB_DC_HZ`], so the steady drag does not push the object off its rest
+//!   position.
 //!
 //! Speed and force are smoothed over [`SMOOTHING_S`], and the force starts from zero, so a contact
 //! starts, stops and moves without a click.
@@ -75,9 +92,20 @@ const BUMP_WIDTH: f64 = 0.25;
 const GROUND_GAIN: f32 = 0.4;
 
 /// Force of a rolling object's tallest bump, relative: held, the factory table rolled on at
-/// 0.6 m/s peaks at -9.6 dBFS, the factory steel sheet scraped at 0.4 m/s at -6.1 dBFS
-/// (`tests/factory_presets.rs`).
+/// 0.6 m/s peaks at -11.4 dBFS over seconds 2 to 4, the factory steel sheet scraped at 0.4 m/s at
+/// -8.5 dBFS (`tests/factory_presets.rs`).
 const BUMP_GAIN: f32 = 16.0;
+
+/// Decay rate a held scrape adds to every mode of the object, 1/s. The scraper is held by a
+/// hand, a lossy mass coupled to the object through a stiff contact: a resistance `R` at a point
+/// adds `R phi^2 / (2 M)` to the decay of a mode of modal mass `M` and shape `phi` there
+/// (Rayleigh's dissipation function), and about 10 N s/m for a hand-held tool against the half
+/// kilogram a mode of a 0.5 x 0.35 m, 1.5 mm steel sheet moves (`rho h S / 4`) gives several per
+/// second. How hard the scraper presses changes the contact's stiffness, not the hand's loss, so
+/// the level stays in proportion to the force. Without it the factory steel sheet's lowest mode
+/// (0.28 /s, T60 25 s) took nearly all of a held scrape and filled over seconds: -6.1 dBFS after
+/// 1 s, +1.3 after 10 s, +3.8 after 300 s.
+const SCRAPE_DAMPING_PER_S: f64 = 3.0;
 
 /// The vertical velocity is in units of the profile's RMS per lowest-octave cell crossed at this
 /// speed, metres per second.
@@ -86,15 +114,19 @@ const REFERENCE_SPEED_M_PER_S: f64 = 1.0;
 /// Static friction coefficient of a rub (at the edge of sticking).
 const RUB_STATIC: f32 = 1.0;
 
-/// Sliding friction coefficient of a rub, far from sticking.
+/// Sliding friction coefficient of a rub at the fastest rub's speed, [`RUB_MAX_SPEED_M_PER_S`].
 const RUB_DYNAMIC: f32 = 0.4;
 
-/// Relative velocity over which a rub's friction falls from static towards sliding, m/s.
-const RUB_FALL_M_PER_S: f32 = 0.2;
+/// Relative velocity at which a rub's friction starts to fall with its logarithm, m/s.
+const RUB_FALL_M_PER_S: f32 = 0.05;
 
-/// Steepness of a rub's sticking branch: the friction reaches its static value within
-/// `RUB_FALL_M_PER_S / RUB_STICK` of sticking.
-const RUB_STICK: f32 = 10.0;
+/// Least friction coefficient, reached only at relative velocities far beyond any rub's (the
+/// logarithm would otherwise turn the friction round).
+const RUB_LEAST: f32 = 0.1;
+
+/// Width of a rub's sticking branch, m/s: within it the friction holds the rubber and the
+/// contact point together.
+const RUB_STICK_M_PER_S: f32 = 0.02;
 
 /// How much the contact point's velocity may answer a change of friction force within one sample,
 /// relative: the rub's sticking branch is never steeper than this share of the explicit loop's
@@ -102,19 +134,27 @@ const RUB_STICK: f32 = 10.0;
 pub const RUB_LOOP_GAIN: f32 = 0.5;
 
 /// Acceleration of the contact point under full friction at full force, m/s^2 (the friction
-/// force over the mass the contact point moves).
-const RUB_ACCELERATION: f64 = 150.0;
+/// force over the mass the contact point moves): enough for the factory glass, the lossiest
+/// rubbed bank (2.3 /s), to sing up to the fastest rub at its default force (0.7); at 300 it
+/// broke away above 1 m/s. More would flatten low modes pressed hard at slow speeds further.
+const RUB_ACCELERATION: f64 = 400.0;
 
 /// Fastest rub, m/s (the fastest contact the engine plays): a rub's level follows its speed.
 const RUB_MAX_SPEED_M_PER_S: f64 = 3.0;
+
+/// Fastest change of a rub's speed, m/s^2: a hand circling a rim takes a second to reach 1 m/s.
+/// Measured on the factory glass at force 0.7, rubbed from rest: at 2 m/s^2 it no longer catches
+/// at 2 and 3 m/s; at 1 m/s^2 it sings at every speed from 0.1 to 3 m/s.
+const RUB_MAX_ACCELERATION_M_PER_S2: f64 = 1.0;
 
 /// Corner of the high-pass on a rub's force, Hz.
 pub const RUB_DC_HZ: f64 = 5.0;
 
 /// The object's velocity at the contact point, m/s, per unit of the modes' summed velocity
 /// (the state the resonators hold for a unit impulse): a rub's steady oscillation swings the
-/// contact point at about the rubbing speed, so this sets its level.
-const RUB_M_PER_S_PER_UNIT: f32 = 1.0;
+/// contact point at about the rubbing speed, so this sets its level: the factory glass and bowl
+/// rubbed at the fastest speed, 3 m/s, peak near -2.5 dBFS, at 0.1 m/s near -33 dBFS.
+const RUB_M_PER_S_PER_UNIT: f32 = 4.0;
 
 /// How an object touches the surface.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -131,6 +171,19 @@ pub enum ContactKind {
     },
     /// Rubbing it: stick-slip friction (its force from [`Contact::rub`], not [`Contact::render`]).
     Rub,
+}
+
+impl ContactKind {
+    /// Decay rate, 1/s, this contact adds to every mode of the object it touches while held: a
+    /// scraper's hand damps the object ([`SCRAPE_DAMPING_PER_S`]). A rolling ball is held on by
+    /// its weight alone, through a contact close to elastic (Hertz), and a rub's loss is its
+    /// friction's own.
+    pub fn damping_per_s(self) -> f64 {
+        match self {
+            ContactKind::Scrape { .. } => SCRAPE_DAMPING_PER_S,
+            ContactKind::Roll { .. } | ContactKind::Rub => 0.0,
+        }
+    }
 }
 
 /// The contact force of one object on one surface.
@@ -176,6 +229,8 @@ pub struct Contact {
     sample_rate_hz: f64,
     /// Smoothing coefficient per sample.
     smoothing: f64,
+    /// Largest change of a rub's speed in one sample, m/s.
+    rub_speed_step: f64,
 }
 
 impl Contact {
@@ -227,6 +282,7 @@ impl Contact {
             rub_pole: (-std::f64::consts::TAU * RUB_DC_HZ / sample_rate_hz).exp() as f32,
             sample_rate_hz,
             smoothing: 1.0 - (-1.0 / (SMOOTHING_S * sample_rate_hz)).exp(),
+            rub_speed_step: RUB_MAX_ACCELERATION_M_PER_S2 / sample_rate_hz,
         }
     }
 
@@ -333,7 +389,9 @@ impl Contact {
         let (target_speed, target_force) = targets(speed_m_per_s, force);
         let target_speed = target_speed.min(RUB_MAX_SPEED_M_PER_S);
         let k = self.smoothing;
-        self.speed += (target_speed - self.speed) * k;
+        // The speed moves as a hand does, at a bounded acceleration.
+        let step = self.rub_speed_step;
+        self.speed += ((target_speed - self.speed) * k).clamp(-step, step);
         self.force += (target_force - self.force) * k as f32;
         // Settled values snap to their targets (no subnormal tail on the way to zero).
         if (target_speed - self.speed).abs() < 1e-9 {
@@ -342,16 +400,15 @@ impl Contact {
         if (target_force - self.force).abs() < 1e-9 {
             self.force = target_force;
         }
-        let relative = (self.speed as f32 - RUB_M_PER_S_PER_UNIT * velocity) / RUB_FALL_M_PER_S;
+        let relative_m_per_s = self.speed as f32 - RUB_M_PER_S_PER_UNIT * velocity;
         // A unit force moves the contact point `RUB_M_PER_S_PER_UNIT * gain_sum` in one sample:
         // full friction at full force accelerates it at `RUB_ACCELERATION`.
         let per_sample = (RUB_ACCELERATION / self.sample_rate_hz) as f32;
         let scale = per_sample / (RUB_M_PER_S_PER_UNIT * gain_sum.max(1e-12));
-        // The sticking branch as steep as asked, or as the one-sample loop allows at this force.
-        let stick = RUB_STICK
-            .min(RUB_LOOP_GAIN * RUB_FALL_M_PER_S / (per_sample * RUB_STATIC * self.force));
-        let friction = (stick * relative).tanh()
-            * (RUB_DYNAMIC + (RUB_STATIC - RUB_DYNAMIC) / (1.0 + relative.abs()));
+        // The sticking branch as narrow as asked, or as the one-sample loop allows at this force.
+        let stick_m_per_s =
+            RUB_STICK_M_PER_S.max(per_sample * RUB_STATIC * self.force / RUB_LOOP_GAIN);
+        let friction = rub_friction(relative_m_per_s, stick_m_per_s);
         let drag = self.force * scale * friction;
         let drag = if drag.is_finite() { drag } else { 0.0 };
         // One-pole high-pass: y = p (y + x - x_prev).
@@ -408,6 +465,20 @@ impl Contact {
         }
         sum
     }
+}
+
+/// A rub's friction coefficient at relative velocity `dv_m_per_s` of rubber and object, with a
+/// sticking branch `stick_m_per_s` wide: `tanh(dv / v_s) (mu_s - c ln(1 + |dv| / v0))`, falling
+/// from [`RUB_STATIC`] to [`RUB_DYNAMIC`] at the fastest rub. Steady sliding friction falling with
+/// the logarithm of the sliding speed is the velocity weakening of rate-and-state friction
+/// (Dieterich 1979; Ruina, *Slip instability and state variable friction laws*, JGR 1983).
+#[inline]
+fn rub_friction(dv_m_per_s: f32, stick_m_per_s: f32) -> f32 {
+    // The fall over the whole range, per unit of the logarithm.
+    let per_log =
+        (RUB_STATIC - RUB_DYNAMIC) / (1.0 + RUB_MAX_SPEED_M_PER_S as f32 / RUB_FALL_M_PER_S).ln();
+    let sliding = RUB_STATIC - per_log * (1.0 + dv_m_per_s.abs() / RUB_FALL_M_PER_S).ln();
+    (dv_m_per_s / stick_m_per_s).tanh() * sliding.max(RUB_LEAST)
 }
 
 /// Speed and force targets with non-finite or negative values taken as zero.

@@ -11,7 +11,8 @@ use super::rng::Rng;
 
 /// Level of a contact's force against a strike's: a scrape at 0.5 m/s and the default force
 /// (0.7), held, drives a bank to about the level of the first half second of a mallet strike at
-/// full velocity (0.1 dB apart on a bank of 200 modes from 110 Hz in `tests/contact.rs`).
+/// full velocity (2.3 dB below it on a bank of 200 modes from 110 Hz in `tests/contact.rs`, the
+/// scraper's hand damping the modes).
 const CONTACT_GAIN: f32 = 3.7e-4;
 
 /// How many overlapping strikes one voice keeps; a further strike replaces the oldest.
@@ -227,6 +228,16 @@ impl Exciter {
     /// Whether a contact is held (under way and not let go).
     pub fn holds_contact(&self) -> bool {
         self.in_contact && !self.contact_released
+    }
+
+    /// Decay rate the contact held adds to every mode of the object, 1/s
+    /// ([`ContactKind::damping_per_s`]); none once it has been let go.
+    pub fn contact_damping_per_s(&self) -> f64 {
+        if self.holds_contact() {
+            self.contact.kind().damping_per_s()
+        } else {
+            0.0
+        }
     }
 
     /// Whether a rub is under way: its force comes sample by sample from [`Exciter::rub_force`]

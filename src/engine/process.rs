@@ -770,6 +770,7 @@ fn tuning_of(v: &Voice, damping_version: u64, release_decay_per_s: f64) -> Tunin
         } else {
             0.0
         },
+        contact_decay_per_s: v.exciter.contact_damping_per_s(),
         // On a contact note pressure is the contact's force, not a hand damping the object.
         log_damping: v.variation_log_damping as f64
             + if v.contact {

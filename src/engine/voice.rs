@@ -69,6 +69,8 @@ pub struct Tuning {
     pub damping_version: u64,
     /// Lowest decay rate imposed by release damping, in 1/s (0 = none).
     pub release_decay_per_s: f64,
+    /// Decay rate a held contact adds to every mode, in 1/s (a scraper's hand damping the object).
+    pub contact_decay_per_s: f64,
     /// Natural log of this voice's own decay multiplier (per-note pressure).
     pub log_damping: f64,
 }
@@ -205,7 +207,8 @@ impl Voice {
     }
 
     /// Recomputes the coefficients of every live mode for `tuning`: angles scale with pitch,
-    /// decays follow frequency (constant Q) with the release decay as a floor, and a mode pushed
+    /// decays follow frequency (constant Q) plus a held contact's damping, with the release decay
+    /// as a floor, and a mode pushed
     /// above `THETA_MAX` is held there and fades out.
     pub fn retune(
         &mut self,
@@ -219,10 +222,11 @@ impl Voice {
         let theta_per_hz = TAU * pitch / sample_rate_hz;
         let inv_rate = 1.0 / sample_rate_hz;
         let release = tuning.release_decay_per_s;
+        let contact = tuning.contact_decay_per_s;
         let fade = t60_to_decay(ABOVE_RANGE_T60_S);
         self.modes.set_poles_with(|m| {
             let theta = bank.freq_hz[m] * theta_per_hz;
-            let decay_per_s = (decay[m] * damping).max(release);
+            let decay_per_s = (decay[m] * damping + contact).max(release);
             if theta < THETA_MAX {
                 (theta, decay_per_s * inv_rate)
             } else {

@@ -153,11 +153,11 @@ pub(super) fn objects() -> Vec<FactoryObject> {
         FactoryObject {
             name: "Rubbed wine glass",
             description: "A thin wine glass rubbed round its rim with a wet finger for as long \
-                          as a key is held: a pure tone that swells from nothing within half \
-                          a second once the finger grips, on the glass's lowest mode. Press \
-                          too lightly or move too fast and it will not sing; it rings on when \
-                          let go. Velocity and pressure set how hard the finger presses, slide \
-                          its speed. The glass's stem is not modelled.",
+                          as a key is held: a pure tone on the glass's lowest mode that swells \
+                          from nothing within a second as the finger gets up to speed, louder \
+                          the faster it goes. Press too lightly for the speed and it will not \
+                          sing; it rings on when let go. Velocity and pressure set how hard the \
+                          finger presses, slide its speed. The glass's stem is not modelled.",
             shape: Shape::Bowl(Bowl {
                 diameter_m: 0.075,
                 thickness_m: 0.0012,
@@ -169,7 +169,7 @@ pub(super) fn objects() -> Vec<FactoryObject> {
                     exciter: "rub",
                     roughness: 0.5,
                     rolling_radius_mm: None,
-                    speed_m_per_s: 0.25,
+                    speed_m_per_s: 0.7,
                     force: 0.7,
                 }),
                 ..Tweaks::NONE
@@ -178,10 +178,10 @@ pub(super) fn objects() -> Vec<FactoryObject> {
         FactoryObject {
             name: "Singing bowl (circled with a stick)",
             description: "A bronze singing bowl circled at its rim with a wooden stick for as \
-                          long as a key is held: a low hum that swells within half a second \
-                          and holds, and rings on for many seconds when the stick leaves it, \
-                          beating slowly as each pair of the bowl's modes drifts in and out \
-                          of step.",
+                          long as a key is held: a low hum that swells within a second, as the \
+                          stick gets up to speed, and holds, and rings on for many seconds when \
+                          the stick leaves it, beating slowly as each pair of the bowl's modes \
+                          drifts in and out of step.",
             shape: Shape::Bowl(Bowl {
                 diameter_m: 0.2,
                 thickness_m: 0.004,
@@ -193,8 +193,8 @@ pub(super) fn objects() -> Vec<FactoryObject> {
                     exciter: "rub",
                     roughness: 0.5,
                     rolling_radius_mm: None,
-                    speed_m_per_s: 0.3,
-                    force: 0.8,
+                    speed_m_per_s: 0.8,
+                    force: 0.7,
                 }),
                 ..Tweaks::NONE
             },
