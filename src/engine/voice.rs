@@ -208,8 +208,7 @@ impl Voice {
 
     /// Recomputes the coefficients of every live mode for `tuning`: angles scale with pitch,
     /// decays follow frequency (constant Q) plus a held contact's damping, with the release decay
-    /// as a floor, and a mode pushed
-    /// above `THETA_MAX` is held there and fades out.
+    /// as a floor, and a mode pushed above `THETA_MAX` is held there and fades out.
     pub fn retune(
         &mut self,
         bank: &PreparedBank,
