@@ -31,7 +31,7 @@ use std::time::Duration;
 
 use crossbeam_channel::{Receiver, Sender};
 use nice_plug::editor::dpi::LogicalSize;
-use nice_plug::prelude::ResizeHint;
+use nice_plug::prelude::{ParamSetter, ResizeHint};
 use nice_plug_egui::{create_egui_editor, EguiEditor, EguiEditorState, EguiNiceSettings};
 
 pub use app::{BankErrorSource, EditorApp, EditorLayout};
@@ -129,6 +129,17 @@ pub struct MeterReading {
     /// Largest share of a block's duration the audio thread spent processing it, since the last
     /// reading (1 = all of it).
     pub dsp_load: f32,
+}
+
+/// What the widgets need of the plugin for one frame.
+#[derive(Clone, Copy)]
+pub struct Host<'a> {
+    /// The parameters.
+    pub params: &'a ModalParams,
+    /// Sets parameters through the host.
+    pub setter: &'a ParamSetter<'a>,
+    /// The audio thread's meters and the strike pad's queue.
+    pub shared: &'a EditorShared,
 }
 
 /// Data the audio thread publishes for the editor, and the strike pad's queue. Owned by the

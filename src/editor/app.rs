@@ -19,7 +19,7 @@ use super::session::BankSession;
 use super::strike_pad::StrikePad;
 use super::window_size::WindowSize;
 use super::{bank_info, mode_editor, params_panel, style};
-use super::{Audition, EditorLinks, EditorShared, MeterReading, METER_INTERVAL_S};
+use super::{Audition, EditorLinks, EditorShared, Host, MeterReading, METER_INTERVAL_S};
 use crate::model::factory::bank_from_state;
 use crate::model::summary::BankSummary;
 use crate::params::ModalParams;
@@ -62,17 +62,6 @@ pub struct EditorLayout {
     pub bank_list: Rect,
     /// The user banks, loading and saving, below the list of factory banks.
     pub bank_files: Rect,
-}
-
-/// What the widgets need of the plugin for one frame.
-#[derive(Clone, Copy)]
-pub struct Host<'a> {
-    /// The parameters.
-    pub params: &'a ModalParams,
-    /// Sets parameters through the host.
-    pub setter: &'a ParamSetter<'a>,
-    /// The audio thread's meters and the strike pad's queue.
-    pub shared: &'a EditorShared,
 }
 
 /// The editor. Lives as long as the plugin instance, across openings of the window.

@@ -9,9 +9,9 @@ use egui::{pos2, vec2, Color32, CornerRadius, FontId, Painter, Pos2, Rect, Respo
 use egui::{Slider, Stroke, Ui, Vec2};
 use nice_plug::prelude::ParamSetter;
 
-use super::app::Host;
 use super::style;
 use super::Audition;
+use super::Host;
 use crate::engine::{PositionMap, StrikeAxis};
 use crate::params::ModalParams;
 
