@@ -346,11 +346,16 @@ const TAIL_SHARE: f64 = 0.25;
 /// amplitude ratio (6 dB): a frame's level of noise or of a neighbour varies that much.
 const TAIL_MARGIN: f64 = 2.0;
 
-/// Makes every mode decay at least as fast as the recording shows it does. Over the last
-/// quarter of the sound, the resynthesis of all the modes may hold at a mode's frequency at most
-/// [`TAIL_MARGIN`] over the most the recording holds there in any frame (or the noise floor
-/// there, if higher); where it holds more, the mode, which rules the resynthesis there, decays
-/// faster until it does not. A weak mode the fits could not follow into the noise (its decay
+/// A mode falling by less than this many nepers over the sound has a decay the fits could
+/// hardly measure: the recording's tail must bear it out.
+const SLOW_FIT_NEPERS: f64 = 1.0;
+
+/// Makes every slow mode decay at least as fast as the recording shows it does. A mode falling
+/// by less than [`SLOW_FIT_NEPERS`] over the sound is checked: over the last quarter of the
+/// sound, the resynthesis of all the modes may hold at its frequency at most [`TAIL_MARGIN`]
+/// over the most the recording holds there in any frame (or the noise floor there, if higher);
+/// where it holds more, the mode, which rules the resynthesis there, decays faster until it
+/// does not. Modes whose decay the fits measured are left as measured. A weak mode the fits could not follow into the noise (its decay
 /// unmeasured, at the floor) would otherwise ring for minutes in every voice where the
 /// recording shows it gone within seconds. A mode still ringing at the end of a recording cut
 /// short keeps its decay, and a beating pair is judged by its sum, so a beat's null in the
@@ -363,6 +368,11 @@ fn decay_as_the_recording_shows(a: &mut Analysis) {
         return;
     }
     let t = tail_start as f64 / rate;
+    let sound_s = a.signal.len() as f64 / rate;
+    let slow = |m: &Found| m.decay_per_s * sound_s < SLOW_FIT_NEPERS;
+    if !a.modes.iter().any(slow) {
+        return;
+    }
     // The resynthesis of the tail alone: each mode's complex amplitude carried to its start.
     let shapes = a.shapes();
     let carried: Vec<Complex64> = a
@@ -388,6 +398,9 @@ fn decay_as_the_recording_shows(a: &mut Analysis) {
     };
     let tail = &a.signal[tail_start..];
     for k in 0..a.modes.len() {
+        if !slow(&a.modes[k]) {
+            continue;
+        }
         let f = a.modes[k].freq_hz;
         let shown = most(tail, f).max(a.floor_amplitude(f));
         let ratio = most(&model, f) / (TAIL_MARGIN * shown);
