@@ -337,13 +337,13 @@ fn amplitude_in(x: &[f64], w: &[f64], sample_rate_hz: f64, freq_hz: f64) -> f64 
     2.0 * sum.norm() / w.iter().sum::<f64>().max(1e-300)
 }
 
-/// The stretch at the end of the sound over which a mode's level is checked against the
-/// recording's, as a share of the sound: long enough that no beat of a close pair leaves it
-/// empty.
+/// The stretch at the end of the sound over which a slow mode's level is checked against the
+/// recording's, as a share of the sound: heard as one window, so its frequency resolution
+/// parts a weak mode from a strong neighbour a few hertz away.
 const TAIL_SHARE: f64 = 0.25;
 
 /// How far a mode may stand above what the recording shows at its frequency in the tail, as an
-/// amplitude ratio (6 dB): a frame's level of noise or of a neighbour varies that much.
+/// amplitude ratio (6 dB).
 const TAIL_MARGIN: f64 = 2.0;
 
 /// A mode falling by less than this many nepers over the sound has a decay the fits could
@@ -352,27 +352,24 @@ const SLOW_FIT_NEPERS: f64 = 1.0;
 
 /// Makes every slow mode decay at least as fast as the recording shows it does. A mode falling
 /// by less than [`SLOW_FIT_NEPERS`] over the sound is checked: over the last quarter of the
-/// sound, the resynthesis of all the modes may hold at its frequency at most [`TAIL_MARGIN`]
-/// over the most the recording holds there in any frame (or the noise floor there, if higher);
+/// sound, seen through one window, the resynthesis of all the modes may hold at its frequency
+/// at most [`TAIL_MARGIN`] over what the recording holds there (or the noise there, if more);
 /// where it holds more, the mode, which rules the resynthesis there, decays faster until it
-/// does not. Modes whose decay the fits measured are left as measured. A weak mode the fits could not follow into the noise (its decay
-/// unmeasured, at the floor) would otherwise ring for minutes in every voice where the
-/// recording shows it gone within seconds. A mode still ringing at the end of a recording cut
-/// short keeps its decay, and a beating pair is judged by its sum, so a beat's null in the
-/// recording is one in the resynthesis too.
+/// does not. A weak mode the fits could not follow into the noise (its decay unmeasured, at the
+/// floor) would otherwise ring for minutes in every voice where the recording shows it gone
+/// within seconds. A mode still ringing at the end of a recording cut short keeps its decay, a
+/// beating pair is judged by its sum, and modes whose decay the fits measured are left as
+/// measured.
 fn decay_as_the_recording_shows(a: &mut Analysis) {
     let rate = a.sample_rate_hz;
-    let len = a.window_len.min(a.signal.len());
     let tail_start = ((1.0 - TAIL_SHARE) * a.signal.len() as f64) as usize;
-    if a.signal.len() < tail_start + len {
+    let tail_len = a.signal.len() - tail_start;
+    let sound_s = a.signal.len() as f64 / rate;
+    let slow = |m: &Found| m.decay_per_s * sound_s < SLOW_FIT_NEPERS;
+    if tail_len < a.window_len || !a.modes.iter().any(slow) {
         return;
     }
     let t = tail_start as f64 / rate;
-    let sound_s = a.signal.len() as f64 / rate;
-    let slow = |m: &Found| m.decay_per_s * sound_s < SLOW_FIT_NEPERS;
-    if !a.modes.iter().any(slow) {
-        return;
-    }
     // The resynthesis of the tail alone: each mode's complex amplitude carried to its start.
     let shapes = a.shapes();
     let carried: Vec<Complex64> = a
@@ -386,27 +383,24 @@ fn decay_as_the_recording_shows(a: &mut Analysis) {
                 )
         })
         .collect();
-    let mut model = vec![0.0; a.signal.len() - tail_start];
+    let mut model = vec![0.0; tail_len];
     add_modes(&mut model, rate, &shapes, &carried);
-    let window = hann(len);
-    let hop = (len / 2).max(1);
-    let most = |x: &[f64], f: f64| {
-        (0..=x.len() - len)
-            .step_by(hop)
-            .map(|n| amplitude_in(&x[n..n + len], &window, rate, f))
-            .fold(0.0, f64::max)
-    };
+    let window = hann(tail_len);
     let tail = &a.signal[tail_start..];
+    // Noise in one bin falls as the window grows: the floor of a frame, scaled to the tail's.
+    let noise_scale = (a.window_len as f64 / tail_len as f64).sqrt();
+    // The window weighs the middle of the tail most.
+    let t_mid = t + 0.5 * tail_len as f64 / rate;
     for k in 0..a.modes.len() {
         if !slow(&a.modes[k]) {
             continue;
         }
         let f = a.modes[k].freq_hz;
-        let shown = most(tail, f).max(a.floor_amplitude(f));
-        let ratio = most(&model, f) / (TAIL_MARGIN * shown);
+        let shown = amplitude_in(tail, &window, rate, f).max(noise_scale * a.floor_amplitude(f));
+        let ratio = amplitude_in(&model, &window, rate, f) / (TAIL_MARGIN * shown);
         if ratio > 1.0 {
             let m = &mut a.modes[k];
-            m.decay_per_s += ratio.ln() / t;
+            m.decay_per_s += ratio.ln() / t_mid;
             m.track.decay_per_s = m.decay_per_s;
         }
     }
