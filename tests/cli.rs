@@ -1693,6 +1693,41 @@ fn quiet_mistakes_are_refused_or_said() {
 }
 
 #[test]
+fn a_normalised_quiet_note_fades_out_instead_of_stopping() {
+    // Raised 48 dB by --normalize, a soft note's tail would stop where its modes fell under the
+    // truncation threshold before the scaling: at -57 dBFS, a cut.
+    let dir = dir_with_bank();
+    let out = run(
+        dir.path(),
+        &[
+            "render",
+            "rosewood-marimba-bar",
+            "--notes",
+            "60:0.05@0",
+            "--normalize",
+            "-1",
+            "-o",
+            "n.wav",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let samples: Vec<f64> = hound::WavReader::open(dir.path().join("n.wav"))
+        .unwrap()
+        .samples::<i32>()
+        .step_by(2)
+        .map(|v| v.unwrap() as f64 / 8_388_608.0)
+        .collect();
+    let last = samples.iter().rposition(|v| *v != 0.0).unwrap();
+    let before = &samples[last.saturating_sub(480)..=last];
+    let level = before.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(
+        20.0 * level.log10() < -80.0,
+        "the 10 ms before the render falls silent peak at {:.1} dBFS",
+        20.0 * level.log10()
+    );
+}
+
+#[test]
 fn a_render_to_dash_goes_to_standard_output() {
     let dir = dir_with_bank();
     let d = dir.path();

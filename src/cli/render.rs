@@ -8,12 +8,13 @@ use std::sync::Arc;
 
 use clap::Args;
 
-use modal_resonator::engine::{Controls, PositionMap, PreparedBank};
+use modal_resonator::engine::{control_range, Controls, PositionMap, PreparedBank};
 use modal_resonator::model::Bank;
 use modal_resonator::render::{
     parse_notes, read_midi_file, render_to, wav_bytes, BitDepth, Note, RenderSettings,
     RenderSummary, Rendered, Score, TimedMidi, WavFile,
 };
+use modal_resonator::units::gain_to_db;
 
 use super::progress::Progress;
 use super::{check_output, load_bank, STDOUT};
@@ -169,19 +170,42 @@ fn render_output(
     settings: &RenderSettings,
     progress: &mut Progress,
 ) -> Result<RenderSummary, String> {
+    let mut settings = settings.clone();
     let (scale, first_share) = match args.normalize {
         Some(peak_dbfs) => {
-            let quiet = |_: &[f32], _: &[f32]| Ok::<(), Infallible>(());
-            let Ok(first) = render_to(bank, score, settings, 1.0, |d| progress.set(0.5 * d), quiet);
-            let scale = if first.peak > 0.0 {
-                10f32.powf(peak_dbfs / 20.0) / first.peak
-            } else {
-                1.0
+            let target = 10f32.powf(peak_dbfs / 20.0);
+            let mut peak_of = |settings: &RenderSettings, from: f64| {
+                let quiet = |_: &[f32], _: &[f32]| Ok::<(), Infallible>(());
+                let share = |d: f64| from + 0.25 * d;
+                let Ok(pass) = render_to(
+                    bank,
+                    score,
+                    settings,
+                    1.0,
+                    |d| progress.set(share(d)),
+                    quiet,
+                );
+                pass.peak
             };
-            (scale, 0.5)
+            let mut peak = peak_of(&settings, 0.0);
+            // Modes stop at the truncation threshold before the scaling: a render to be raised
+            // stops them as far lower (down to the lowest threshold), or its tail would end in an
+            // audible cut; its peak is measured again with that threshold, since more modes
+            // start under it.
+            if peak > 0.0 && target > peak {
+                let lowest = control_range("truncation_db").0;
+                let lowered =
+                    (settings.controls.truncation_db - gain_to_db(target / peak)).max(lowest);
+                if lowered < settings.controls.truncation_db {
+                    settings.controls.truncation_db = lowered;
+                    peak = peak_of(&settings, 0.25);
+                }
+            }
+            (if peak > 0.0 { target / peak } else { 1.0 }, 0.5)
         }
         None => (1.0, 0.0),
     };
+    let settings = &settings;
     let share = |done: f64| first_share + (1.0 - first_share) * done;
     if args.output.as_os_str() != STDOUT {
         let mut file =
