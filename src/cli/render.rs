@@ -260,7 +260,7 @@ fn report(args: &RenderArgs, rendered: &RenderSummary, score: Score, elapsed_s: 
     let over = rendered.peak > 1.0;
     let clipped = args.bits != BitDepth::Float32 && over;
     let summary = format!(
-        "{}: {:.2} s, {} Hz {}, peak {:.1} dBFS{}, up to {} voices, rendered in {:.2} s{}",
+        "{}: {:.2} s, {} Hz {}, peak {:+.1} dBFS{}, up to {} voice{}, rendered in {:.2} s{}",
         if to_stdout {
             "standard output".into()
         } else {
@@ -272,6 +272,7 @@ fn report(args: &RenderArgs, rendered: &RenderSummary, score: Score, elapsed_s: 
         peak_dbfs,
         if clipped { " (clipped)" } else { "" },
         rendered.max_voices,
+        if rendered.max_voices == 1 { "" } else { "s" },
         elapsed_s,
         if rendered.cut_short {
             ", cut at --max-seconds"

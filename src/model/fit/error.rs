@@ -113,7 +113,7 @@ impl fmt::Display for FitError {
             ),
             FitError::Silent { name, detail } => write!(
                 f,
-                "{name}: no strike found: {detail}; check the file holds the recording of a strike"
+                "{name}: {detail}; check the file holds the recording of a strike"
             ),
             FitError::Clipped { name, fraction } => write!(
                 f,

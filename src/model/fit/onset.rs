@@ -63,7 +63,7 @@ pub fn find_strike(x: &[f64], sample_rate_hz: f64) -> Result<Strike, String> {
     let energies = block_energies(x, block);
     let peak = energies.iter().copied().fold(0.0, f64::max);
     if peak <= 0.0 {
-        return Err("silence: every sample is zero".to_string());
+        return Err("no strike: every sample is zero".to_string());
     }
     let mut sorted = energies.clone();
     let rank = ((sorted.len() - 1) as f64 * NOISE_PERCENTILE).round() as usize;
