@@ -19,7 +19,7 @@ use std::process::ExitCode;
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 use modal_resonator::model::factory::{factory_bank, factory_banks, factory_slug};
-use modal_resonator::model::staged::{destination, exit_removing_temporaries};
+use modal_resonator::model::staged::{destination, exit_removing_temporaries, temp_beside};
 use modal_resonator::model::{load_bank_file, Bank};
 
 /// Modal Resonator: modal-synthesis instrument and bank tool.
@@ -331,9 +331,8 @@ pub(super) fn check_output(
             dir.display()
         ));
     }
-    let probe = tempfile::Builder::new()
-        .prefix(".modal-resonator-probe-")
-        .tempfile_in(dir);
+    // Noted like every temporary file, so an interrupt meanwhile removes it too.
+    let probe = temp_beside(&target, ".modal-resonator-probe-", ".tmp");
     match probe {
         Ok(file) => {
             let _ = file.close();
