@@ -23,7 +23,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use modal_resonator::model::fit::{fit_bank, FitOptions, Recording};
+use modal_resonator::authoring::fit::{fit_bank, FitOptions, Recording};
 
 // Shared with the integration tests, which use other parts of them.
 #[allow(dead_code)]

@@ -11,8 +11,8 @@
 use std::process::Command;
 use std::time::Instant;
 
-use modal_resonator::model::materials::{BRONZE, STEEL};
-use modal_resonator::model::mesh::{generate, solve_modes, MeshSettings};
+use modal_resonator::authoring::materials::{BRONZE, STEEL};
+use modal_resonator::authoring::mesh::{generate, solve_modes, MeshSettings};
 
 /// Set in a child process to the case it runs.
 const CASE_VAR: &str = "MESH_BENCH_CASE";

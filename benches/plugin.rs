@@ -13,8 +13,8 @@ use std::time::Instant;
 
 use common::bench_bank;
 use common::clap::{run, with_bank, Script, Send, INSTRUMENT};
+use modal_resonator::bank::Bank;
 use modal_resonator::engine::{Engine, NoteEvent, PreparedBank};
-use modal_resonator::model::Bank;
 use modal_resonator::params::ModalParams;
 
 const RATE_HZ: f32 = 48_000.0;

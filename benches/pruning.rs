@@ -28,9 +28,9 @@ use std::hint::black_box;
 use std::sync::Arc;
 use std::time::Instant;
 
+use modal_resonator::bank::{Bank, Position};
 use modal_resonator::dsp::ExciterKind;
 use modal_resonator::engine::{Controls, Engine, NoteEvent, PreparedBank};
-use modal_resonator::model::{Bank, Position};
 
 #[path = "pruning/bands.rs"]
 mod bands;

@@ -40,8 +40,8 @@ pub use params_panel::fixed_strike_axes;
 pub use session::BankSession;
 pub use slider::control_rect;
 
+use crate::bank::validate::MAX_MODES;
 use crate::engine::{Engine, Note, NoteEvent, VoiceModulation};
-use crate::model::validate::MAX_MODES;
 use crate::params::ModalParams;
 
 /// Size the editor opens at, in logical pixels.

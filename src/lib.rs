@@ -1,13 +1,14 @@
 //! Modal Resonator: a modal-synthesis instrument.
 //!
-//! A *modal bank* ([`model::Bank`]) describes how an object rings: modes with a frequency, a decay
+//! A *modal bank* ([`bank::Bank`]) describes how an object rings: modes with a frequency, a decay
 //! rate and a gain for each strike position. The [`engine::Engine`] plays banks polyphonically
 //! through SIMD resonator banks ([`dsp`]); [`render`] drives the same engine offline.
 
+pub mod authoring;
+pub mod bank;
 pub mod dsp;
 pub mod editor;
 pub mod engine;
-pub mod model;
 pub mod params;
 pub mod plugin;
 pub mod render;

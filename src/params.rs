@@ -7,11 +7,11 @@ use std::sync::RwLock;
 use nice_plug::params::persist::PersistentField;
 use nice_plug::prelude::*;
 
+use crate::bank::factory::{factory_bank, DEFAULT_FACTORY_BANK};
 use crate::engine::{
     control_range, Controls, ExciterKind, Material, VoiceModulation, MATERIAL_Q_RANGE,
     MAX_POLYPHONY,
 };
-use crate::model::factory::{factory_bank, DEFAULT_FACTORY_BANK};
 
 mod pruning;
 

@@ -18,11 +18,11 @@ pub use midi_file::{read_midi_file, TimedMidi};
 pub use notes::{parse_notes, Note};
 pub use wav::{to_int_sample, wav_bytes, write_wav, BitDepth, WavEncoder, WavFile};
 
+use crate::bank::Bank;
 use crate::engine::{
     Controls, Engine, ExciterKind, MidiInput, MidiMessage, NoteEvent, NoteExpression, PositionMap,
     PreparedBank, CONTACT_SPEED_MAX_M_PER_S,
 };
-use crate::model::Bank;
 use crate::units::{db_to_gain, gain_to_db};
 
 /// Silence kept after the last sound (or the last event, if later), in seconds: enough that a
@@ -417,7 +417,7 @@ const RESYNTHESIS_KEY: u8 = 60;
 /// `bank` struck at position `position` with a unit impulse and rendered mono through the
 /// engine for `len` samples at `sample_rate_hz`, in the bank's own units: the engine's loudness
 /// normalisation is undone, so a mode of gain `a` starts at amplitude `a`. What the fit's score
-/// (`model::fit::synthesize_strike`) stands for.
+/// (`authoring::fit::synthesize_strike`) stands for.
 pub fn resynthesize(bank: &Bank, position: usize, sample_rate_hz: u32, len: usize) -> Vec<f32> {
     let prepared = Arc::new(PreparedBank::new(bank));
     let mut controls = Controls::for_bank(bank);

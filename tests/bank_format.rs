@@ -7,10 +7,10 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use modal_resonator::model::io::{bank_to_json, BankErrorKind};
-use modal_resonator::model::schema::bank_schema_json;
-use modal_resonator::model::validate::{validate_bank, MAX_REPORTED_PROBLEMS};
-use modal_resonator::model::{
+use modal_resonator::bank::io::{bank_to_json, BankErrorKind};
+use modal_resonator::bank::schema::bank_schema_json;
+use modal_resonator::bank::validate::{validate_bank, MAX_REPORTED_PROBLEMS};
+use modal_resonator::bank::{
     load_bank_file, parse_bank_str, save_bank_file, Bank, BankDefaults, BankError, Mode, Position,
     MAX_BANK_FILE_BYTES, MAX_JSON_VALUES,
 };
@@ -466,7 +466,7 @@ fn points_in_space_are_positions() {
                       {"name": "base", "coords": [0.0, 0.0, 0.0]}],
         "modes": [{"freq_hz": 1200, "decay_per_s": 2.0, "gains": [1.0, 0.2]}]
     }"#;
-    let bank = modal_resonator::model::parse_bank_str(text, "cup.json").expect("a 3-D bank loads");
+    let bank = modal_resonator::bank::parse_bank_str(text, "cup.json").expect("a 3-D bank loads");
     assert_eq!(bank.positions[0].coords, vec![0.04, 0.0, 0.09]);
 }
 

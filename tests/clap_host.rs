@@ -10,7 +10,7 @@ use clack_host::events::event_types::NoteExpressionType;
 use clack_host::prelude::*;
 use common::clap::*;
 use common::{magnitude_at, peak, pitch_hz, spectral_peak_hz};
-use modal_resonator::model::{Bank, Mode, Position};
+use modal_resonator::bank::{Bank, Mode, Position};
 use modal_resonator::units::gain_to_db;
 
 #[test]
@@ -954,8 +954,8 @@ fn a_bank_swap_fades_the_ringing_bank_out_without_a_click() {
 #[test]
 fn the_default_bank_peaks_near_minus_6_dbfs_at_its_root() {
     // Default parameters strike the default bank at its typical point with its own mallet.
-    let bank = modal_resonator::model::factory::factory_bank(
-        modal_resonator::model::factory::DEFAULT_FACTORY_BANK,
+    let bank = modal_resonator::bank::factory::factory_bank(
+        modal_resonator::bank::factory::DEFAULT_FACTORY_BANK,
     )
     .unwrap();
     let root = modal_resonator::units::hz_to_midi_key(bank.effective_root_hz()).round() as u16;

@@ -814,7 +814,7 @@ fn banks_go_to_standard_output_for_a_dash() {
         let out = run(dir.path(), args);
         assert!(out.status.success(), "{args:?}: {}", stderr(&out));
         // Standard output holds the bank alone; the summary goes to standard error.
-        let bank = modal_resonator::model::parse_bank_str(&stdout(&out), "stdout")
+        let bank = modal_resonator::bank::parse_bank_str(&stdout(&out), "stdout")
             .unwrap_or_else(|e| panic!("{args:?}: {e}"));
         assert!(!bank.modes.is_empty(), "{args:?}");
         assert!(
@@ -854,7 +854,7 @@ fn fit_writes_a_bank_and_a_report_from_recordings() {
     // The stereo file was mixed to mono, and says so.
     assert!(stderr(&out).contains("centre: stereo"), "{}", stderr(&out));
 
-    let bank = modal_resonator::model::load_bank_file(&dir.path().join("fitted.json")).unwrap();
+    let bank = modal_resonator::bank::load_bank_file(&dir.path().join("fitted.json")).unwrap();
     assert_eq!(bank.name, "fitted");
     assert_eq!(bank.license, "CC0-1.0");
     let names: Vec<&str> = bank.positions.iter().map(|p| p.name.as_str()).collect();
@@ -862,7 +862,7 @@ fn fit_writes_a_bank_and_a_report_from_recordings() {
     // The two modes struck, and nothing else within 60 dB of them: the rest fits the 16-bit
     // rounding, and no listener hears it.
     let loudest =
-        |m: &modal_resonator::model::Mode| m.gains.iter().fold(0.0f64, |a, g| a.max(g.abs()));
+        |m: &modal_resonator::bank::Mode| m.gains.iter().fold(0.0f64, |a, g| a.max(g.abs()));
     let mut modes: Vec<_> = bank.modes.iter().collect();
     modes.sort_by(|a, b| loudest(b).total_cmp(&loudest(a)));
     let mut strongest: Vec<f64> = modes[..2].iter().map(|m| m.freq_hz).collect();
@@ -1038,7 +1038,7 @@ fn shape_builds_a_stated_steel_bar_and_prints_its_summary() {
     assert!(text.contains("root 576.50 Hz"), "{text}");
     // Modes below 20 kHz: b_n L up to (2 * 8 + 1) pi / 2, at 18.37 kHz.
     assert!(text.contains("bar.json: 8 modes, 4 positions"), "{text}");
-    let bank = modal_resonator::model::load_bank_file(&dir.path().join("bar.json")).unwrap();
+    let bank = modal_resonator::bank::load_bank_file(&dir.path().join("bar.json")).unwrap();
     assert_eq!(bank.modes.len(), 8);
     assert_eq!(bank.license, "CC0-1.0");
     let ratio = bank.modes[1].freq_hz / bank.modes[0].freq_hz;
@@ -1070,7 +1070,7 @@ fn shape_tunes_takes_positions_and_limits() {
         ],
     );
     assert!(out.status.success(), "{}", stderr(&out));
-    let bank = modal_resonator::model::load_bank_file(&dir.path().join("disc.json")).unwrap();
+    let bank = modal_resonator::bank::load_bank_file(&dir.path().join("disc.json")).unwrap();
     assert_eq!(bank.name, "Test disc");
     assert!((bank.root_hz.unwrap() - 440.0).abs() < 1e-9);
     assert_eq!(bank.modes.len(), 20);
@@ -1232,7 +1232,7 @@ fn compress_merges_and_drops_and_reports() {
         (3000.0, 6.0, 1e-5),
     ]);
     bank.root_hz = Some(2000.0);
-    modal_resonator::model::save_bank_file(&bank, &dir.path().join("bank.json")).unwrap();
+    modal_resonator::bank::save_bank_file(&bank, &dir.path().join("bank.json")).unwrap();
     let out = run(dir.path(), &["compress", "bank.json", "-o", "small.json"]);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(
@@ -1240,7 +1240,7 @@ fn compress_merges_and_drops_and_reports() {
         "{}",
         stdout(&out)
     );
-    let small = modal_resonator::model::load_bank_file(&dir.path().join("small.json")).unwrap();
+    let small = modal_resonator::bank::load_bank_file(&dir.path().join("small.json")).unwrap();
     assert_eq!(small.modes.len(), 2);
     assert!((small.modes[0].gains[0] - 1.5).abs() < 1e-12);
     let kept = run(
@@ -1578,10 +1578,7 @@ fn list_keeps_its_columns_and_the_docs_count_the_banks_it_lists() {
     let ends: Vec<usize> = lines.iter().map(|l| l.find(" modes").unwrap()).collect();
     assert!(ends.iter().all(|&e| e == ends[0]), "{text}");
     let count = lines.len();
-    assert_eq!(
-        count,
-        modal_resonator::model::factory::factory_banks().len()
-    );
+    assert_eq!(count, modal_resonator::bank::factory::factory_banks().len());
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
     assert!(
@@ -2014,7 +2011,7 @@ fn a_strike_setting_along_an_axis_the_bank_lacks_is_reported() {
 
 /// A binary STL of a box `size` (in the file's units) from the origin.
 fn write_box_stl(path: &Path, size: [f64; 3]) {
-    let surface = modal_resonator::model::mesh::generate::cuboid(size);
+    let surface = modal_resonator::authoring::mesh::generate::cuboid(size);
     let mut bytes = vec![0u8; 80];
     bytes.extend((surface.triangles.len() as u32).to_le_bytes());
     for t in 0..surface.triangles.len() {
@@ -2054,7 +2051,7 @@ fn mesh_makes_a_bank_from_an_stl_in_millimetres() {
     let text = stdout(&out);
     assert!(text.contains("6 rigid motions left out"), "{text}");
     // The first bending mode within 1 % of Euler-Bernoulli's 576.50 Hz.
-    let bank = modal_resonator::model::load_bank_file(&dir.path().join("bar-mesh.json")).unwrap();
+    let bank = modal_resonator::bank::load_bank_file(&dir.path().join("bar-mesh.json")).unwrap();
     let root = bank.root_hz.unwrap();
     assert!((root / 576.5 - 1.0).abs() < 0.01, "root {root}: {text}");
     assert_eq!(bank.positions[1].name, "middle");
@@ -2092,7 +2089,7 @@ fn mesh_makes_a_bank_from_an_stl_in_millimetres() {
         "{}",
         stdout(&out)
     );
-    let tine = modal_resonator::model::load_bank_file(&dir.path().join("tine.json")).unwrap();
+    let tine = modal_resonator::bank::load_bank_file(&dir.path().join("tine.json")).unwrap();
     let lowest = tine.modes[0].freq_hz;
     assert!((lowest / 90.6 - 1.0).abs() < 0.03, "cantilever {lowest} Hz");
 
@@ -2118,7 +2115,7 @@ fn mesh_makes_a_bank_from_an_stl_in_millimetres() {
         ],
     );
     assert!(out.status.success(), "{}", stderr(&out));
-    let matched = modal_resonator::model::load_bank_file(&dir.path().join("matched.json")).unwrap();
+    let matched = modal_resonator::bank::load_bank_file(&dir.path().join("matched.json")).unwrap();
     let at_440 = matched
         .modes
         .iter()
@@ -2155,7 +2152,7 @@ fn mesh_seeks_modes_up_to_a_frequency_limit() {
         "{}",
         stderr(&out)
     );
-    let bank = modal_resonator::model::load_bank_file(&dir.path().join("all.json")).unwrap();
+    let bank = modal_resonator::bank::load_bank_file(&dir.path().join("all.json")).unwrap();
     // Those the strike points excite (the rest have no gain anywhere).
     assert!(bank.modes.len() > 100, "{} modes", bank.modes.len());
     // With a limit the first 100 reach, one solve: every mode kept lies below it.
@@ -2173,7 +2170,7 @@ fn mesh_seeks_modes_up_to_a_frequency_limit() {
         ],
     );
     assert!(out.status.success(), "{}", stderr(&out));
-    let low = modal_resonator::model::load_bank_file(&dir.path().join("low.json")).unwrap();
+    let low = modal_resonator::bank::load_bank_file(&dir.path().join("low.json")).unwrap();
     assert!(
         low.modes.iter().all(|m| m.freq_hz < 3000.0),
         "{:?}",
@@ -2351,7 +2348,7 @@ fn mesh_default_strike_points_sound_a_bar_s_fundamental() {
     );
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
-    let bank = modal_resonator::model::load_bank_file(&dir.path().join("bar.json")).unwrap();
+    let bank = modal_resonator::bank::load_bank_file(&dir.path().join("bar.json")).unwrap();
     assert_eq!(bank.positions.len(), 6);
     // The first bending mode (Euler-Bernoulli 576.50 Hz), not the width-bending 1,671 Hz.
     let root = bank.root_hz.unwrap();

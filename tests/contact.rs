@@ -6,9 +6,9 @@
 mod common;
 
 use common::*;
+use modal_resonator::bank::Bank;
 use modal_resonator::dsp::ExciterKind;
 use modal_resonator::engine::{Engine, Note, NoteEvent, NoteExpression};
-use modal_resonator::model::Bank;
 
 const RATE: f32 = 48_000.0;
 const KEY: u8 = 60;
@@ -107,7 +107,7 @@ fn a_held_scrape_settles_however_long_its_object_rings() {
 
 #[test]
 fn the_factory_scraped_and_rolled_banks_hold_a_steady_level_without_clipping() {
-    use modal_resonator::model::factory::factory_bank;
+    use modal_resonator::bank::factory::factory_bank;
     use modal_resonator::units::{gain_to_db, hz_to_midi_key};
     // The steel sheet's lowest mode rings for 25 s; the table top's for 2.3 s.
     for slug in ["scraped-steel-sheet", "spruce-table-top-rolled-ball"] {
@@ -386,7 +386,7 @@ fn a_rubbed_glass_sings_at_its_clearest_mode_while_held_and_rings_on_after() {
 
 #[test]
 fn a_rub_sings_louder_the_faster_it_goes_across_the_speed_range() {
-    use modal_resonator::model::factory::factory_bank;
+    use modal_resonator::bank::factory::factory_bank;
     use modal_resonator::units::{gain_to_db, hz_to_midi_key};
     // The factory glass and bowl at their own force, rubbed from rest at speeds across the
     // contact range (0 to 3 m/s): each sings on its lowest mode, louder the faster, and the fastest

@@ -11,14 +11,14 @@ use std::time::Duration;
 
 use egui::{pos2, vec2, Event, Key, Modifiers, Pos2, Rect};
 use harness::{at, Harness};
+use modal_resonator::bank::factory::{factory_bank, factory_banks};
+use modal_resonator::bank::io::bank_to_json;
+use modal_resonator::bank::{load_bank_file, Bank};
 use modal_resonator::editor::{control_rect, fixed_strike_axes};
 use modal_resonator::editor::{
     Audition, EditorShared, EDITOR_MIN_SIZE, EDITOR_SIZE, METER_INTERVAL_S, MODE_VIEW_DB_SPAN,
 };
 use modal_resonator::engine::{Controls, Engine, NoteEvent, PreparedBank};
-use modal_resonator::model::factory::{factory_bank, factory_banks};
-use modal_resonator::model::io::bank_to_json;
-use modal_resonator::model::{load_bank_file, Bank};
 use nice_plug::prelude::{Param, Params};
 
 /// Most space between two widgets stacked in a panel, in points.

@@ -7,9 +7,9 @@ use std::cell::Cell;
 use std::sync::Arc;
 use std::time::Duration;
 
+use modal_resonator::bank::factory::factory_bank;
 use modal_resonator::editor::{Audition, EditorShared};
 use modal_resonator::engine::{Controls, Engine, NoteEvent, PreparedBank};
-use modal_resonator::model::factory::factory_bank;
 
 struct Counting;
 

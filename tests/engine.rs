@@ -3,11 +3,11 @@
 mod common;
 
 use common::*;
+use modal_resonator::bank::{Bank, BankDefaults, Mode};
 use modal_resonator::engine::{
     Controls, Engine, Note, NoteEvent, NoteExpression, PreparedBank, VoiceModulation,
     CONTROL_PERIOD, MAX_POLYPHONY, TARGET_PEAK,
 };
-use modal_resonator::model::{Bank, BankDefaults, Mode};
 use modal_resonator::units::{db_to_gain, gain_to_db, midi_key_to_hz, t60_to_decay};
 use std::sync::Arc;
 
@@ -98,7 +98,7 @@ fn a_strike_peaks_near_minus_6_dbfs_at_every_rate() {
 /// within 1 dB of -6 dBFS; a slower one is refused.
 #[test]
 fn the_lowest_mode_a_bank_may_hold_keeps_the_strike_level() {
-    use modal_resonator::model::validate::validate_bank;
+    use modal_resonator::bank::validate::validate_bank;
     let mut bank = simple_bank(&[(1.0, 0.0, 1.0), (220.0, 2.0, 0.3)]);
     bank.root_hz = Some(220.0);
     let problems = validate_bank(&bank);
@@ -297,7 +297,7 @@ fn voices_are_stolen_quietest_first_with_a_fade() {
 
 /// Renders `bank` struck at t = 0, changing controls to `to` at 0.1 s; returns the output and
 /// the same render with `to` from the start.
-fn sweep(bank: &modal_resonator::model::Bank, to: &Controls) -> (Vec<f32>, Vec<f32>) {
+fn sweep(bank: &modal_resonator::bank::Bank, to: &Controls) -> (Vec<f32>, Vec<f32>) {
     let mut e = engine(bank, RATE);
     let mut l = vec![0.0; 24_000];
     let mut r = vec![0.0; 24_000];
@@ -422,9 +422,9 @@ fn modes_above_the_limit_are_not_played() {
 }
 
 /// Two modes, 300 Hz sounding only at position a (x = 0), 1.7 kHz only at b (x = 1).
-fn a_mode_per_position() -> modal_resonator::model::Bank {
+fn a_mode_per_position() -> modal_resonator::bank::Bank {
     let mut bank = simple_bank(&[(300.0, 2.0, 1.0), (1_700.0, 2.0, 0.0)]);
-    bank.positions.push(modal_resonator::model::Position {
+    bank.positions.push(modal_resonator::bank::Position {
         name: "b".into(),
         coords: vec![1.0],
     });
@@ -653,7 +653,7 @@ fn width_zero_is_mono_and_width_spreads_modes() {
 fn position_variation_moves_each_strike() {
     // Each position excites one mode: where a strike lands shows in the balance of the two.
     let mut bank = simple_bank(&[(300.0, 2.0, 1.0), (1_100.0, 2.0, 0.0)]);
-    bank.positions.push(modal_resonator::model::Position {
+    bank.positions.push(modal_resonator::bank::Position {
         name: "b".into(),
         coords: vec![1.0],
     });
@@ -733,7 +733,7 @@ fn strikes_between_2d_positions_blend_their_gains() {
     bank.positions = ["a", "b", "c"]
         .iter()
         .zip([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
-        .map(|(n, c)| modal_resonator::model::Position {
+        .map(|(n, c)| modal_resonator::bank::Position {
             name: n.to_string(),
             coords: c.to_vec(),
         })
@@ -760,7 +760,7 @@ fn strikes_between_2d_positions_blend_their_gains() {
 #[test]
 fn truncation_drops_less_than_the_threshold_in_all() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/steel-plate.json");
-    let bank = modal_resonator::model::load_bank_file(&path).unwrap();
+    let bank = modal_resonator::bank::load_bank_file(&path).unwrap();
     for truncation_db in [-60.0f32, -96.0] {
         let run = |db: f32| {
             let mut e = engine(&bank, RATE);
@@ -1017,7 +1017,7 @@ fn the_same_key_on_two_channels_plays_two_voices_that_bend_apart() {
 }
 
 /// One mode at 440 Hz, rooted at A4, ringing for seconds.
-fn sine_like_bank() -> modal_resonator::model::Bank {
+fn sine_like_bank() -> modal_resonator::bank::Bank {
     let mut bank = simple_bank(&[(440.0, 1.0, 1.0)]);
     bank.root_hz = Some(440.0);
     bank
@@ -1114,7 +1114,7 @@ fn input_gain_changes_glide_instead_of_stepping() {
 
 #[test]
 fn gains_at_a_strike_point_match_mode_by_mode() {
-    let banks = modal_resonator::model::factory::analytic_factory_banks();
+    let banks = modal_resonator::bank::factory::analytic_factory_banks();
     let mut blended = 0;
     for bank in banks.iter().filter(|b| b.positions.len() > 1) {
         let prepared = modal_resonator::engine::PreparedBank::new(bank);

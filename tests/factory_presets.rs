@@ -1,25 +1,27 @@
-//! The committed factory presets match what `src/model/factory/` generates, and every factory
+//! The committed analytic presets are what their recipes (`src/authoring/factory_recipes/`)
+//! design and the factory plays exactly those files, and every factory
 //! bank, analytic or fitted, validates and plays: non-silent, finite, and peaking near -6 dBFS
 //! when struck at full velocity on its root key with its own defaults.
 //!
-//! `UPDATE_PRESETS=1 cargo test factory_presets` rewrites `presets/<slug>.json` and the factory
+//! `UPDATE_PRESETS=1 cargo test --test factory_presets` rewrites `presets/<slug>.json` and the factory
 //! table in `presets/README.md` instead of checking them. (The fitted banks in `presets/fitted/`
 //! are rewritten by `tests/fit_recordings.rs`.)
 
 mod common;
 
-use modal_resonator::model::factory::{
+use modal_resonator::authoring::factory_recipes::{designed_factory_banks, write_factory_presets};
+use modal_resonator::bank::factory::{
     analytic_factory_banks, factory_banks, factory_slug, factory_table_markdown, first_difference,
-    splice_factory_table, write_factory_presets, FACTORY_TABLE_FILE,
+    splice_factory_table, FACTORY_TABLE_FILE,
 };
-use modal_resonator::model::Bank;
+use modal_resonator::bank::Bank;
 use std::path::PathBuf;
 
 /// Numbers in the committed files may differ from a fresh build in the last bits (a platform's
 /// `sin` or `exp`, or the JSON parser's rounding); anything larger is a real change.
 const REL_TOL: f64 = 1e-9;
 
-const HOW_TO_UPDATE: &str = "run UPDATE_PRESETS=1 cargo test factory_presets";
+const HOW_TO_UPDATE: &str = "run UPDATE_PRESETS=1 cargo test --test factory_presets";
 
 fn presets_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("presets")
@@ -33,7 +35,7 @@ fn updating() -> bool {
 fn factory_presets_are_up_to_date() {
     let dir = presets_dir();
     let table = factory_table_markdown(&factory_banks());
-    let banks = analytic_factory_banks();
+    let banks = designed_factory_banks();
     if updating() {
         let paths = write_factory_presets(&dir).expect("writing the factory presets");
         let readme_path = dir.join(FACTORY_TABLE_FILE);
@@ -67,6 +69,14 @@ fn factory_presets_are_up_to_date() {
             Err(err) => stale.push(format!("{}: {err}", path.display())),
         }
     }
+    // The factory plays the files in `src/bank/factory/analytic.rs`: the recipes' list, in order.
+    let designed: Vec<String> = banks.iter().map(factory_slug).collect();
+    let played: Vec<String> = analytic_factory_banks().iter().map(factory_slug).collect();
+    if played != designed {
+        stale.push(format!(
+            "src/bank/factory/analytic.rs embeds {played:?}, the recipes design {designed:?}"
+        ));
+    }
     let table_path = dir.join(FACTORY_TABLE_FILE);
     match std::fs::read_to_string(&table_path) {
         Ok(committed)
@@ -88,7 +98,7 @@ const PEAK_TOLERANCE_DB: f32 = 1.5;
 
 #[test]
 fn every_factory_bank_validates_and_plays_near_minus_6_dbfs_at_its_root() {
-    use modal_resonator::model::validate::validate_bank;
+    use modal_resonator::bank::validate::validate_bank;
     use modal_resonator::units::{gain_to_db, hz_to_midi_key};
 
     let rate = 48_000.0;

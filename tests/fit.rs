@@ -5,13 +5,13 @@ mod common;
 
 use std::sync::Arc;
 
-use modal_resonator::dsp::ExciterKind;
-use modal_resonator::engine::{Controls, PreparedBank};
-use modal_resonator::model::fit::{
+use modal_resonator::authoring::fit::{
     compare, fit_bank, synthesize_strike, FitError, FitOptions, Recording,
 };
+use modal_resonator::dsp::ExciterKind;
+use modal_resonator::engine::{Controls, PreparedBank};
 
-use modal_resonator::model::{Bank, Mode, Position};
+use modal_resonator::bank::{Bank, Mode, Position};
 use modal_resonator::render::{render, resynthesize, Note, CUT_FADE_S};
 
 const RATE: u32 = 48_000;
@@ -848,7 +848,7 @@ fn most_amplitude_from(x: &[f64], from: usize, freq_hz: f64) -> f64 {
 /// The factory bank `name` struck at `key` as `render` plays it (the left channel), its ring
 /// decaying into -70 dBFS of noise over `seconds`, in 16 bits, and its fit.
 fn noisy_factory_strike(name: &str, key: u8, seconds: f64) -> (Bank, Vec<f64>, Bank) {
-    let bank = modal_resonator::model::factory::factory_bank(name).unwrap();
+    let bank = modal_resonator::bank::factory::factory_bank(name).unwrap();
     let len = (seconds * RATE as f64) as usize;
     let settings = modal_resonator::render::RenderSettings {
         sample_rate_hz: RATE,

@@ -7,7 +7,7 @@ mod common;
 
 use common::corpus::select;
 use common::fit_score::{fitted_modes, score};
-use modal_resonator::model::fit::{fit_bank, FitOptions};
+use modal_resonator::authoring::fit::{fit_bank, FitOptions};
 
 /// A recording, the highest score (mean absolute dB over all frames) its fit may reach, and
 /// the highest median error in cents of the modes nearest its five strongest spectral peaks.

@@ -10,8 +10,8 @@ mod common;
 use std::path::PathBuf;
 
 use common::recordings::{RealRecording, REAL_RECORDINGS};
-use modal_resonator::model::fit::{compare, fit_bank, FitOptions};
-use modal_resonator::model::{load_bank_file, save_bank_file, Bank, BankDefaults};
+use modal_resonator::authoring::fit::{compare, fit_bank, FitOptions};
+use modal_resonator::bank::{load_bank_file, save_bank_file, Bank, BankDefaults};
 use modal_resonator::render::resynthesize;
 use serde_json::json;
 

@@ -5,7 +5,7 @@
 mod common;
 
 use common::fit_score::{score, synthesize, FittedMode, Score};
-use modal_resonator::model::fit::Recording;
+use modal_resonator::authoring::fit::Recording;
 
 /// Sample rate of the test recordings.
 const RATE_HZ: u32 = 44_100;

@@ -4,14 +4,14 @@
 
 use std::f64::consts::TAU;
 
-use modal_resonator::model::materials::{Material, STEEL};
-use modal_resonator::model::mesh::{
+use modal_resonator::authoring::materials::{Material, STEEL};
+use modal_resonator::authoring::mesh::{
     bank_from_modes, generate, parse_surface, solve_modes, solve_modes_within,
     spread_strike_points, strike_points, write_obj, Clamp, MeshError, MeshModes, MeshSettings,
     MeshSource, StrikeRequest, Surface,
 };
-use modal_resonator::model::shapes::{CircularPlate, ModeLimits, PlateEdge, Shape};
-use modal_resonator::model::Position;
+use modal_resonator::authoring::shapes::{CircularPlate, ModeLimits, PlateEdge, Shape};
+use modal_resonator::bank::Position;
 
 /// The bar of the tests: 300 x 30 x 10 mm, vibrating in its thin direction along z.
 const BAR_M: [f64; 3] = [0.3, 0.03, 0.01];
@@ -534,9 +534,9 @@ fn stl_and_obj_give_the_same_surface() {
 
 #[test]
 fn a_mesh_matched_to_a_recording_at_one_point_has_the_object_s_gains_at_the_others() {
-    use modal_resonator::model::fit::{fit_bank, FitOptions, Recording};
-    use modal_resonator::model::mesh::combine_with_recording;
-    use modal_resonator::model::shapes::{bar::Bar, build_bank};
+    use modal_resonator::authoring::fit::{fit_bank, FitOptions, Recording};
+    use modal_resonator::authoring::mesh::combine_with_recording;
+    use modal_resonator::authoring::shapes::{bar::Bar, build_bank};
     use modal_resonator::render::resynthesize;
 
     // The analytic bar (Euler-Bernoulli) at four points along its centre line, struck at its end

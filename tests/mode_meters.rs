@@ -22,7 +22,7 @@ fn energies(e: &Engine) -> (Vec<f32>, Vec<usize>) {
 }
 
 /// An engine with impulse strikes and no stereo spread, so a mode's state is its gain.
-fn impulse_engine(bank: &modal_resonator::model::Bank, truncation_db: f32) -> Engine {
+fn impulse_engine(bank: &modal_resonator::bank::Bank, truncation_db: f32) -> Engine {
     let mut e = engine(bank, RATE);
     let mut c = e.controls().clone();
     c.exciter = ExciterKind::Impulse;

@@ -5,8 +5,8 @@ mod common;
 use std::path::PathBuf;
 
 use common::*;
-use modal_resonator::model::io::{bank_to_json, load_bank_file, parse_bank_str};
-use modal_resonator::model::validate::validate_bank;
+use modal_resonator::bank::io::{bank_to_json, load_bank_file, parse_bank_str};
+use modal_resonator::bank::validate::validate_bank;
 use modal_resonator::units::hz_to_midi_key;
 
 /// The banks in `presets/` and in `presets/fitted/` (banks fitted to recordings).

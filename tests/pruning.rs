@@ -5,9 +5,9 @@
 mod common;
 
 use common::*;
+use modal_resonator::bank::{Bank, Mode};
 use modal_resonator::dsp::ExciterKind;
 use modal_resonator::engine::{Controls, Engine, Note, NoteEvent, CONTROL_PERIOD};
-use modal_resonator::model::{Bank, Mode};
 
 const RATE: f32 = 48_000.0;
 

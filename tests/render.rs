@@ -10,8 +10,8 @@ use midly::{
     Format, Fps, Header, MetaMessage, MidiMessage, Smf, Timing, TrackEvent, TrackEventKind,
 };
 
+use modal_resonator::bank::Bank;
 use modal_resonator::engine::{MidiMessage as EngineMidi, PreparedBank};
-use modal_resonator::model::Bank;
 use modal_resonator::render::{
     parse_notes, read_midi_file, render, to_int_sample, write_wav, BitDepth, Note, RenderSettings,
     Rendered, WavFile, TAIL_MARGIN_S,
@@ -907,7 +907,7 @@ fn a_strike_under_the_root_peaks_no_higher_than_the_root() {
         "bronze-flat-gong",
         "porcelain-cup-meshed",
     ] {
-        let bank = modal_resonator::model::factory::factory_bank(name).unwrap();
+        let bank = modal_resonator::bank::factory::factory_bank(name).unwrap();
         let prepared = Arc::new(PreparedBank::new(&bank));
         let settings = RenderSettings {
             sample_rate_hz: RATE,

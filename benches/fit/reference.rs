@@ -13,7 +13,7 @@
 //! the intercept at the onset divided by the window's gain for a sinusoid, rather than eq. 6.3's
 //! sum over a window, so that it is the amplitude of `a sin`.
 
-use modal_resonator::model::fit::Recording;
+use modal_resonator::authoring::fit::Recording;
 use realfft::RealFftPlanner;
 
 use crate::fit_score::{onset_index, FittedMode};

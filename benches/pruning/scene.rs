@@ -2,9 +2,9 @@
 //! each a rectangular plate of its material (seed 000 section 3.1), struck by a Poisson rain of
 //! impacts whose energies follow a 1/E law.
 
-use modal_resonator::model::materials::{self, Material};
-use modal_resonator::model::shapes::{ModeLimits, RectangularPlate, Shape, MAX_AUDIBLE_HZ};
-use modal_resonator::model::{Bank, Mode, Position};
+use modal_resonator::authoring::materials::{self, Material};
+use modal_resonator::authoring::shapes::{ModeLimits, RectangularPlate, Shape, MAX_AUDIBLE_HZ};
+use modal_resonator::bank::{Bank, Mode, Position};
 
 use crate::RATE_HZ;
 

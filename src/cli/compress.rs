@@ -1,11 +1,11 @@
 //! `modal-resonator compress`: a bank made cheaper by merging modes a listener cannot tell apart
-//! and dropping weak ones (the library's `model::compress`).
+//! and dropping weak ones (the library's `authoring::compress`).
 
 use std::path::{Path, PathBuf};
 
 use clap::Args;
 
-use modal_resonator::model::compress::{compress_bank, CompressOptions, DEFAULT_DROP_BELOW_DB};
+use modal_resonator::authoring::compress::{compress_bank, CompressOptions, DEFAULT_DROP_BELOW_DB};
 
 use super::{check_output, load_bank, output_name, save_bank_output, say};
 

@@ -4,12 +4,12 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 
-use modal_resonator::model::fit::{
+use modal_resonator::authoring::fit::{
     fit_bank_with_progress, read_wav_recording, stage_report_file, FitOptions, DEFAULT_MAX_MODES,
 };
-use modal_resonator::model::{commit_all, stage_bank_file};
+use modal_resonator::bank::{commit_all, stage_bank_file};
 
-use modal_resonator::model::validate::validate_bank;
+use modal_resonator::bank::validate::validate_bank;
 
 use super::progress::Progress;
 use super::{check_output, is_stdout, output_name, same_file, save_bank_output, say};

@@ -1,6 +1,6 @@
 //! `modal-resonator info`: a bank described.
 
-use modal_resonator::model::summary::BankSummary;
+use modal_resonator::bank::summary::BankSummary;
 
 use super::load_bank;
 

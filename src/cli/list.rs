@@ -1,6 +1,6 @@
 //! `modal-resonator list`: the factory banks.
 
-use modal_resonator::model::factory::{factory_banks, factory_slug};
+use modal_resonator::bank::factory::{factory_banks, factory_slug};
 
 /// Prints one line per factory bank: slug, number of modes, licence and name, in columns as
 /// wide as their longest entry.

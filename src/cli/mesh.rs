@@ -1,23 +1,23 @@
-//! `modal-resonator mesh`: a bank from a 3-D model (the library's `model::mesh`).
+//! `modal-resonator mesh`: a bank from a 3-D model (the library's `authoring::mesh`).
 
 use std::path::PathBuf;
 
 use clap::Args;
 use sha2::{Digest, Sha256};
 
-use modal_resonator::model::fit::{
+use modal_resonator::authoring::fit::{
     fit_bank_with_progress, read_wav_recording, FitOptions, Recording,
 };
-use modal_resonator::model::materials::Material;
-use modal_resonator::model::mesh::strike::spread_names;
-use modal_resonator::model::mesh::{
+use modal_resonator::authoring::materials::Material;
+use modal_resonator::authoring::mesh::strike::spread_names;
+use modal_resonator::authoring::mesh::{
     bank_from_modes, check_elements, combine_with_recording, parse_surface, solve_modes_within,
     spread_strike_points, strike_points, unit_warning, Clamp, MeshError, MeshModes, MeshSettings,
     MeshSource, MeshStage, SolveStage, StrikePoint, StrikeRequest, Surface, DEFAULT_ELEMENTS,
     DEFAULT_MAX_SOLVE_BYTES, MAX_MODES,
 };
-use modal_resonator::model::shapes::{ModeLimits, MAX_AUDIBLE_HZ};
-use modal_resonator::model::summary::note_name;
+use modal_resonator::authoring::shapes::{ModeLimits, MAX_AUDIBLE_HZ};
+use modal_resonator::bank::summary::note_name;
 
 use super::progress::Progress;
 use super::shape::{parse_loss_factor, parse_material, parse_positive};
@@ -288,11 +288,11 @@ fn recording_point(
 
 /// `bank` combined with `recording` (of the file `file_name`), struck at position `at`.
 fn matched(
-    bank: modal_resonator::model::Bank,
+    bank: modal_resonator::bank::Bank,
     recording: &Recording,
     at: usize,
     file_name: &str,
-) -> Result<modal_resonator::model::Bank, String> {
+) -> Result<modal_resonator::bank::Bank, String> {
     let name = bank.positions[at].name.clone();
     let options = FitOptions {
         name: bank.name.clone(),
@@ -568,7 +568,7 @@ fn clamps(specs: &[String], surface: &Surface, scale: f64) -> Result<Vec<Clamp>,
 }
 
 /// Prints what was made.
-fn report(args: &MeshArgs, modes: &MeshModes, bank: &modal_resonator::model::Bank) {
+fn report(args: &MeshArgs, modes: &MeshModes, bank: &modal_resonator::bank::Bank) {
     let stats = &modes.stats;
     let say = |line: &str| say(&args.output, line);
     say(&bank.description);

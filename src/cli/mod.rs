@@ -18,9 +18,9 @@ use std::process::ExitCode;
 
 use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
-use modal_resonator::model::factory::{factory_bank, factory_banks, factory_slug};
-use modal_resonator::model::staged::{destination, exit_removing_temporaries, temp_beside};
-use modal_resonator::model::{load_bank_file, Bank};
+use modal_resonator::bank::factory::{factory_bank, factory_banks, factory_slug};
+use modal_resonator::bank::staged::{destination, exit_removing_temporaries, temp_beside};
+use modal_resonator::bank::{load_bank_file, Bank};
 
 /// Modal Resonator: modal-synthesis instrument and bank tool.
 #[derive(Debug, Parser)]
@@ -254,9 +254,9 @@ pub(super) fn is_stdout(output: &Path) -> bool {
 /// either way; nothing is written when it fails.
 pub(super) fn save_bank_output(bank: &Bank, output: &Path) -> Result<(), String> {
     if !is_stdout(output) {
-        return modal_resonator::model::save_bank_file(bank, output).map_err(|e| e.to_string());
+        return modal_resonator::bank::save_bank_file(bank, output).map_err(|e| e.to_string());
     }
-    let problems = modal_resonator::model::validate::validate_bank(bank);
+    let problems = modal_resonator::bank::validate::validate_bank(bank);
     if let Some(first) = problems.first() {
         return Err(format!(
             "standard output: the bank is not valid ({} problems), first: {first}",
@@ -264,7 +264,7 @@ pub(super) fn save_bank_output(bank: &Bank, output: &Path) -> Result<(), String>
         ));
     }
     use std::io::Write;
-    let json = modal_resonator::model::io::bank_to_json(bank);
+    let json = modal_resonator::bank::io::bank_to_json(bank);
     let mut stdout = std::io::stdout().lock();
     stdout
         .write_all(json.as_bytes())

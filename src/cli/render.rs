@@ -8,8 +8,8 @@ use std::sync::Arc;
 
 use clap::Args;
 
+use modal_resonator::bank::Bank;
 use modal_resonator::engine::{control_range, Controls, PositionMap, PreparedBank};
-use modal_resonator::model::Bank;
 use modal_resonator::render::{
     parse_notes, read_midi_file, render_to, wav_bytes, BitDepth, Note, RenderSettings,
     RenderSummary, Rendered, Score, TimedMidi, WavFile,

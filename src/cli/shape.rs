@@ -1,16 +1,16 @@
-//! `modal-resonator shape`: a bank from an analytic object (the library's `model::shapes`).
+//! `modal-resonator shape`: a bank from an analytic object (the library's `authoring::shapes`).
 
 use std::path::PathBuf;
 
 use clap::Args;
 
-use modal_resonator::model::materials::{Material, MATERIALS};
-use modal_resonator::model::shapes::{
+use modal_resonator::authoring::materials::{Material, MATERIALS};
+use modal_resonator::authoring::shapes::{
     design_bank, BankDesign, Dimension, ModeLimits, ObjectKind, ObjectSpec, PlateEdge, BAR_TUNINGS,
     DEFAULT_MAX_MODES, MAX_AUDIBLE_HZ, OBJECTS,
 };
-use modal_resonator::model::summary::{note_name, note_to_midi_key};
-use modal_resonator::model::Position;
+use modal_resonator::bank::summary::{note_name, note_to_midi_key};
+use modal_resonator::bank::Position;
 use modal_resonator::units::{decay_to_t60_s, midi_key_to_hz};
 
 use super::{check_output, output_name, save_bank_output, say};

@@ -2,9 +2,9 @@
 
 use std::path::PathBuf;
 
-use modal_resonator::model::factory::factory_bank;
-use modal_resonator::model::load_bank_file;
-use modal_resonator::model::validate::validate_bank;
+use modal_resonator::bank::factory::factory_bank;
+use modal_resonator::bank::load_bank_file;
+use modal_resonator::bank::validate::validate_bank;
 
 /// `validate`: every problem of every file; fails if any file has one. A name that is no file
 /// but a factory preset's (as `info` takes) checks that preset.

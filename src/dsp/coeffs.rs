@@ -19,7 +19,7 @@
 
 use std::f64::consts::TAU;
 
-use crate::model::bank::MAX_FREQ_RATIO;
+use crate::bank::format::MAX_FREQ_RATIO;
 
 /// The recursion coefficient `q = p - 1` of one mode.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -109,7 +109,7 @@ pub fn coeffs_batch(theta: &[f64], delta: &[f64], q_re: &mut [f32], q_im: &mut [
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::bank::MAX_FREQ_RATIO;
+    use crate::bank::format::MAX_FREQ_RATIO;
 
     #[test]
     fn batch_matches_the_scalar_formula() {

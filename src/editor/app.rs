@@ -20,8 +20,8 @@ use super::strike_pad::StrikePad;
 use super::window_size::WindowSize;
 use super::{bank_info, mode_editor, params_panel, style};
 use super::{Audition, EditorLinks, EditorShared, Host, MeterReading, METER_INTERVAL_S};
-use crate::model::factory::bank_from_state;
-use crate::model::summary::BankSummary;
+use crate::bank::factory::bank_from_state;
+use crate::bank::summary::BankSummary;
 use crate::params::ModalParams;
 
 mod flow;

@@ -10,9 +10,9 @@ use nice_plug::prelude::ParamSetter;
 
 use super::session::BankSession;
 use super::style;
+use crate::bank::factory::{factory_bank, factory_banks, factory_slug};
+use crate::bank::{load_bank_file, save_bank_file, Bank};
 use crate::engine::Controls;
-use crate::model::factory::{factory_bank, factory_banks, factory_slug};
-use crate::model::{load_bank_file, save_bank_file, Bank};
 use crate::params::{ExciterChoice, MaterialChoice, ModalParams};
 
 /// How often the user folder is listed again while the browser shows.

@@ -3,8 +3,8 @@
 use egui::{Grid, RichText, Ui};
 use serde_json::Value;
 
-use crate::model::summary::{note_name, BankSummary};
-use crate::model::Bank;
+use crate::bank::summary::{note_name, BankSummary};
+use crate::bank::Bank;
 
 /// Draws the facts about `bank` (`summary` is its summary).
 pub fn show(ui: &mut Ui, bank: &Bank, summary: &BankSummary, origin: &str, edited: bool) {

@@ -4,8 +4,8 @@
 use egui::{DragValue, Grid, RichText, Ui};
 
 use super::session::BankSession;
+use crate::bank::summary::note_name;
 use crate::engine::PositionWeights;
-use crate::model::summary::note_name;
 use crate::units::{decay_to_t60_s, t60_to_decay};
 
 /// Longest T60 an edit sets, in seconds (decay 0, ringing forever, stays as loaded).

@@ -13,8 +13,8 @@ use super::session::BankSession;
 mod plot;
 
 use super::style;
+use crate::bank::summary::note_name;
 use crate::engine::PositionWeights;
-use crate::model::summary::note_name;
 use crate::units::decay_to_t60_s;
 pub use plot::DB_SPAN;
 use plot::{axes_for, cross, db_to_gain, draw_axes, draw_legend, gain_db, Axes, Mapping, MARGINS};
@@ -360,7 +360,7 @@ fn describe(session: &BankSession, input: &ViewInput, i: usize) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::factory::factory_bank;
+    use crate::bank::factory::factory_bank;
 
     #[test]
     fn hovering_tells_a_pruned_mode_from_a_computed_and_a_truncated_one() {

@@ -4,16 +4,16 @@
 
 use serde_json::Value;
 
+use crate::bank::validate::{validate_bank, DECAY_PER_S, FREQ_HZ, GAIN};
+use crate::bank::Bank;
 use crate::engine::{PositionMap, PositionWeights, PreparedBank};
-use crate::model::validate::{validate_bank, DECAY_PER_S, FREQ_HZ, GAIN};
-use crate::model::Bank;
 
 /// Most values (gains, frequencies and decays) the undo history keeps; the oldest steps go
 /// first. 8 M values is 64 MB: hundreds of steps of a large bank.
 const UNDO_BUDGET_VALUES: usize = 8_000_000;
 
 /// Lowest frequency an edit sets, in Hz: the lowest the format allows.
-const MIN_EDIT_FREQ_HZ: f64 = crate::model::validate::MODE_FREQ_HZ.min;
+const MIN_EDIT_FREQ_HZ: f64 = crate::bank::validate::MODE_FREQ_HZ.min;
 
 /// The state one undo step restores.
 #[derive(Debug, Clone, PartialEq)]
@@ -360,7 +360,7 @@ impl BankSession {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::factory::factory_bank;
+    use crate::bank::factory::factory_bank;
 
     fn session() -> BankSession {
         BankSession::new(factory_bank("steel-plate").unwrap(), "test", 1)

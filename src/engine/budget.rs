@@ -7,8 +7,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use super::{Controls, Engine, NoteEvent, PreparedBank, CONTROL_PERIOD};
+use crate::bank::{Bank, Mode, Position};
 use crate::dsp::Kernel;
-use crate::model::{Bank, Mode, Position};
 
 /// Seed 000 eq. 6.6: the share of the measured capacity the automatic budget uses (`C = 0.9`),
 /// leaving room for everything but the resonators.

@@ -7,12 +7,12 @@ mod target;
 pub use target::ExpressionTarget;
 
 use super::position::PositionMap;
-use crate::dsp::ExciterKind;
-use crate::model::validate::{
+use crate::bank::validate::{
     NumberRange, CONTACT_FORCE, CONTACT_SPEED_M_PER_S, DAMPING_TILT, HARDNESS_MS, MATERIAL_Q,
     ROLLING_RADIUS_MM, ROUGHNESS,
 };
-use crate::model::Bank;
+use crate::bank::Bank;
+use crate::dsp::ExciterKind;
 
 /// Most voices the engine can play at once.
 pub const MAX_POLYPHONY: usize = 64;

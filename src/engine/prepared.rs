@@ -7,10 +7,10 @@ use super::controls::Controls;
 use super::pitch_level::PitchLevel;
 use super::position::{PositionMap, PositionWeights};
 use super::stereo::{balanced_pans, lane_weights, COLUMN_PAN};
+use crate::bank::format::MIN_DECAY_PER_S;
+use crate::bank::Bank;
 use crate::dsp::coeffs::ModeCoeffs;
 use crate::dsp::{Exciter, ExciterKind, Kernel, ResonatorBank, COLUMNS};
-use crate::model::bank::MIN_DECAY_PER_S;
-use crate::model::Bank;
 use crate::units::hz_to_midi_key;
 
 /// Peak of a full-velocity strike with the bank's default controls (its default strike
@@ -209,7 +209,7 @@ impl PreparedBank {
         let n = self.num_modes();
         let mut bank = ResonatorBank::new(n);
         let w = self.positions.weights(controls.strike_x, controls.strike_y);
-        let theta_max = TAU * crate::model::bank::MAX_FREQ_RATIO;
+        let theta_max = TAU * crate::bank::format::MAX_FREQ_RATIO;
         let log_damping = self.log_damping(controls.material_q);
         for m in 0..n {
             let theta = TAU * self.freq_hz[m] / MEASURE_RATE_HZ;

@@ -5,9 +5,9 @@ use std::f64::consts::TAU;
 use super::prepared::PreparedBank;
 use super::pruning::fade_samples;
 use super::{NoteExpression, VoiceModulation, MAX_EXPRESSION_SEMITONES};
+use crate::bank::format::MAX_FREQ_RATIO;
 use crate::dsp::coeffs::ModeCoeffs;
 use crate::dsp::{Exciter, ExciterKind, ResonatorBank};
-use crate::model::bank::MAX_FREQ_RATIO;
 use crate::units::t60_to_decay;
 
 /// Pole angle (radians per sample) above which a mode is not started, and at which a sounding

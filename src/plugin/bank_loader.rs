@@ -2,8 +2,8 @@
 
 use std::sync::Arc;
 
+use crate::bank::Bank;
 use crate::engine::{Engine, PreparedBank};
-use crate::model::Bank;
 
 /// An engine built for a bank, on its way to the audio thread.
 pub struct LoadedEngine {

@@ -234,8 +234,8 @@ mod tests {
     use std::sync::Arc;
 
     use super::*;
+    use crate::bank::{Bank, Mode, Position};
     use crate::engine::PreparedBank;
-    use crate::model::{Bank, Mode, Position};
 
     /// An engine playing a bank of `modes` modes, with voices reserved for `polyphony`.
     fn engine(modes: usize, polyphony: usize) -> Box<Engine> {

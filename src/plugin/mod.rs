@@ -21,13 +21,13 @@ pub use bank_loader::{build_engine, LoadedEngine};
 pub use events::VST3_MIDI_CONTROLLERS;
 pub use kind::{Effect, Instrument, Kind};
 
+use crate::bank::factory::bank_from_state;
 use crate::dsp::denormal::flush_subnormals;
 use crate::editor::{self, EditorApp, EditorLinks, EditorShared, AUDITION_NOTE_ID};
 use crate::engine::{
     mix_to_mono, Bypass, Controls, DryWet, EndedVoice, MidiInput, NoteEvent as EngineEvent,
     OnsetTrigger, PositionMap, MAX_POLYPHONY,
 };
-use crate::model::factory::bank_from_state;
 use crate::params::{InputMode, ModalParams, STATE_FORMAT, STATE_FORMAT_FIELD};
 use engines::Engines;
 use poly::PolyTable;

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use super::{RenderError, Rendered};
 use tempfile::NamedTempFile;
 
-use crate::model::staged::{destination, temp_beside};
+use crate::bank::staged::{destination, temp_beside};
 
 /// Sample format of a WAV file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

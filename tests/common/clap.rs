@@ -511,8 +511,8 @@ pub fn run(script: &Script) -> Session {
 }
 
 /// `state` (a saved CLAP state: length, then JSON) with `bank` as its saved bank.
-pub fn with_bank(state: &[u8], bank: &modal_resonator::model::Bank) -> Vec<u8> {
-    with_bank_text(state, &modal_resonator::model::io::bank_to_json(bank))
+pub fn with_bank(state: &[u8], bank: &modal_resonator::bank::Bank) -> Vec<u8> {
+    with_bank_text(state, &modal_resonator::bank::io::bank_to_json(bank))
 }
 
 /// The saved bank's JSON text in `state`.
@@ -532,7 +532,7 @@ pub fn with_bank_text(state: &[u8], text: &str) -> Vec<u8> {
 }
 
 /// A one-mode bank at `freq_hz`, rooted there.
-pub fn sine_bank(freq_hz: f64) -> modal_resonator::model::Bank {
+pub fn sine_bank(freq_hz: f64) -> modal_resonator::bank::Bank {
     let mut bank = super::simple_bank(&[(freq_hz, 3.0, 1.0)]);
     bank.root_hz = Some(freq_hz);
     bank

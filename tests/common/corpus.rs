@@ -11,7 +11,7 @@
 
 use std::path::{Path, PathBuf};
 
-use modal_resonator::model::fit::Recording;
+use modal_resonator::authoring::fit::Recording;
 
 use super::decode::{read_flac, read_gus_patch};
 use super::sf2::SoundFont;

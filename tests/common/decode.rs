@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use modal_resonator::model::fit::Recording;
+use modal_resonator::authoring::fit::Recording;
 
 /// A FLAC file as mono (channels averaged), full scale 1.
 pub fn read_flac(path: &Path, position: &str) -> Recording {

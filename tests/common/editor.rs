@@ -7,9 +7,9 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 
 use egui::{pos2, vec2, Event, Modifiers, PointerButton, Pos2, RawInput, Rect, Vec2};
+use modal_resonator::bank::io::bank_to_json;
+use modal_resonator::bank::{parse_bank_str, Bank};
 use modal_resonator::editor::{Audition, EditorApp, EditorLinks, EditorShared, EDITOR_SIZE};
-use modal_resonator::model::io::bank_to_json;
-use modal_resonator::model::{parse_bank_str, Bank};
 use modal_resonator::params::ModalParams;
 use nice_plug::prelude::*;
 

@@ -16,8 +16,8 @@
 
 use std::f64::consts::TAU;
 
-use modal_resonator::model::fit::Recording;
-use modal_resonator::model::Bank;
+use modal_resonator::authoring::fit::Recording;
+use modal_resonator::bank::Bank;
 use realfft::RealFftPlanner;
 
 /// Onset threshold, relative to the recording's peak.

@@ -10,8 +10,8 @@ pub mod sf2;
 
 use std::sync::Arc;
 
+use modal_resonator::bank::{Bank, Mode, Position};
 use modal_resonator::engine::{Engine, NoteEvent, PreparedBank};
-use modal_resonator::model::{Bank, Mode, Position};
 
 /// A 1-D bank of `modes` given as `(freq_hz, decay_per_s, gain)`, with a single position.
 pub fn simple_bank(modes: &[(f64, f64, f64)]) -> Bank {
@@ -200,16 +200,16 @@ pub fn magnitude_at(x: &[f32], rate: f64, freq_hz: f64) -> f64 {
 
 /// The benchmarks' bank: 256 modes ringing for about a minute, so every mode stays live for
 /// the whole run.
-pub fn bench_bank() -> modal_resonator::model::Bank {
-    let mut bank = modal_resonator::model::Bank::new(
+pub fn bench_bank() -> modal_resonator::bank::Bank {
+    let mut bank = modal_resonator::bank::Bank::new(
         "bench",
-        vec![modal_resonator::model::Position {
+        vec![modal_resonator::bank::Position {
             name: "a".into(),
             coords: vec![0.0],
         }],
     );
     bank.modes = (0..256)
-        .map(|i| modal_resonator::model::Mode {
+        .map(|i| modal_resonator::bank::Mode {
             freq_hz: 60.0 * (1.0 + i as f64 * 0.37),
             decay_per_s: 0.2,
             gains: vec![1.0 / (1.0 + i as f64)],

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use modal_resonator::model::fit::Recording;
+use modal_resonator::authoring::fit::Recording;
 
 use super::decode::{read_flac, read_gus_patch};
 

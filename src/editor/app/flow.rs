@@ -8,11 +8,11 @@ use nice_plug::prelude::ParamSetter;
 use nice_plug_egui::resizable_window::paint_resize_corner;
 
 use super::EditorApp;
+use crate::bank::factory::bank_from_state;
+use crate::bank::io::bank_to_json;
 use crate::editor::bank_browser::{apply_bank_defaults, Loaded};
 use crate::editor::session::BankSession;
 use crate::editor::{EDITOR_MIN_SIZE, METER_INTERVAL_S};
-use crate::model::factory::bank_from_state;
-use crate::model::io::bank_to_json;
 
 impl EditorApp {
     /// Follows the bank saved in the plugin when something else changed it (a host restoring

@@ -82,12 +82,12 @@ fn pruning_controls_are_set_by_name_within_their_ranges() {
 
 #[test]
 fn banks_name_exactly_the_engines_exciters() {
+    use crate::bank::validate::EXCITER_NAMES;
     use crate::dsp::ExciterKind;
-    use crate::model::validate::EXCITER_NAMES;
     assert_eq!(EXCITER_NAMES, ExciterKind::ALL.map(|k| k.name()));
     // The schema offers the same names.
     let schema: serde_json::Value =
-        serde_json::from_str(&crate::model::schema::bank_schema_json()).unwrap();
+        serde_json::from_str(&crate::bank::schema::bank_schema_json()).unwrap();
     let offered = schema["$defs"]["BankDefaults"]["properties"]["exciter"]["enum"].clone();
     assert_eq!(
         offered,
