@@ -1102,3 +1102,76 @@ fn validator_and_types_agree_on_the_fields() {
         assert_eq!(keys(properties), keys(object));
     }
 }
+
+/// The schema's bounds are the validator's: every numeric range, list length and name list that
+/// `presets/modal-bank.schema.json` states is the constant `bank::validate` checks, so an editor
+/// that follows the schema and the program that loads the bank agree.
+#[test]
+fn schema_bounds_are_the_validators() {
+    use modal_resonator::bank::validate::{
+        NumberRange, DECAY_PER_S, DEFAULTS_RANGES, EXCITER_NAMES, FREQ_HZ, GAIN, MAX_COORDS,
+        MAX_MODES, MAX_POSITIONS, MODE_FREQ_HZ,
+    };
+    let schema: Value = serde_json::from_str(&bank_schema_json()).unwrap();
+    let defs = &schema["$defs"];
+    let number = |v: &Value| v.as_f64();
+    let check_range = |where_: &str, property: &Value, range: &NumberRange| {
+        let (min_key, other_key) = if range.min_inclusive {
+            ("minimum", "exclusiveMinimum")
+        } else {
+            ("exclusiveMinimum", "minimum")
+        };
+        assert_eq!(
+            number(&property[min_key]),
+            Some(range.min),
+            "{where_}: schema {min_key} {} vs validator {range:?}",
+            property[min_key]
+        );
+        assert!(property[other_key].is_null(), "{where_}: {property}");
+        assert_eq!(
+            number(&property["maximum"]),
+            Some(range.max),
+            "{where_}: schema maximum {} vs validator {range:?}",
+            property["maximum"]
+        );
+    };
+    check_range("root_hz", &schema["properties"]["root_hz"], &FREQ_HZ);
+    let mode = &defs["Mode"]["properties"];
+    check_range("modes[].freq_hz", &mode["freq_hz"], &MODE_FREQ_HZ);
+    check_range("modes[].decay_per_s", &mode["decay_per_s"], &DECAY_PER_S);
+    check_range("modes[].gains[]", &mode["gains"]["items"], &GAIN);
+    let lengths = [
+        ("positions", &schema["properties"]["positions"], MAX_POSITIONS),
+        ("modes", &schema["properties"]["modes"], MAX_MODES),
+        ("modes[].gains", &mode["gains"], MAX_POSITIONS),
+        (
+            "positions[].coords",
+            &defs["Position"]["properties"]["coords"],
+            MAX_COORDS,
+        ),
+    ];
+    for (where_, property, max) in lengths {
+        assert_eq!(property["minItems"].as_u64(), Some(1), "{where_}");
+        assert_eq!(property["maxItems"].as_u64(), Some(max as u64), "{where_}");
+    }
+    let defaults = &defs["BankDefaults"]["properties"];
+    let numeric: Vec<&str> = defaults
+        .as_object()
+        .unwrap()
+        .iter()
+        .filter(|(_, p)| p["type"][0] == "number")
+        .map(|(name, _)| name.as_str())
+        .collect();
+    let ranged: Vec<&str> = DEFAULTS_RANGES.iter().map(|(name, _)| *name).collect();
+    assert_eq!(numeric.len(), ranged.len(), "{numeric:?} vs {ranged:?}");
+    for (name, range) in &DEFAULTS_RANGES {
+        check_range(&format!("defaults.{name}"), &defaults[*name], range);
+    }
+    let exciters: Vec<&str> = defaults["exciter"]["enum"]
+        .as_array()
+        .expect("defaults.exciter lists its names")
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    assert_eq!(exciters, EXCITER_NAMES);
+}
