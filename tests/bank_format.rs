@@ -1141,7 +1141,11 @@ fn schema_bounds_are_the_validators() {
     check_range("modes[].decay_per_s", &mode["decay_per_s"], &DECAY_PER_S);
     check_range("modes[].gains[]", &mode["gains"]["items"], &GAIN);
     let lengths = [
-        ("positions", &schema["properties"]["positions"], MAX_POSITIONS),
+        (
+            "positions",
+            &schema["properties"]["positions"],
+            MAX_POSITIONS,
+        ),
         ("modes", &schema["properties"]["modes"], MAX_MODES),
         ("modes[].gains", &mode["gains"], MAX_POSITIONS),
         (

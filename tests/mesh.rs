@@ -6,9 +6,9 @@ use std::f64::consts::TAU;
 
 use modal_resonator::authoring::materials::{Material, STEEL};
 use modal_resonator::authoring::mesh::{
-    bank_from_modes, generate, parse_surface, solve_modes, solve_modes_within,
+    bank_from_modes, generate, parse_surface, solve_modes, solve_modes_up_to, solve_modes_within,
     spread_strike_points, strike_points, write_obj, Clamp, MeshError, MeshModes, MeshSettings,
-    MeshSource, StrikeRequest, Surface,
+    MeshSource, StrikeRequest, Surface, DEFAULT_MAX_SOLVE_BYTES,
 };
 use modal_resonator::authoring::shapes::{CircularPlate, ModeLimits, PlateEdge, Shape};
 use modal_resonator::bank::Position;
@@ -888,4 +888,40 @@ fn default_strike_points_sound_a_bar_s_first_bending_mode() {
     );
     let well = levels_db.iter().filter(|&&l| l > -3.0).count();
     assert!(well >= 3, "points within 3 dB: {levels_db:.1?}");
+}
+
+/// Modes up to a frequency: the solve is repeated with twice as many modes until one reaches
+/// the limit, and what it finds is the lowest modes of one solve with that many.
+#[test]
+fn modes_are_sought_up_to_a_frequency_by_doubling() {
+    let bar = generate::cuboid(BAR_M);
+    let few = solve(&bar, 1000, vec![], 2);
+    let limit_hz = few.freqs_hz[1] * 4.0;
+    let mut settings = steel(1000, 2);
+    let found = solve_modes_up_to(
+        &bar,
+        &mut settings,
+        limit_hz,
+        DEFAULT_MAX_SOLVE_BYTES,
+        &mut |_| {},
+    )
+    .expect("the bar solves");
+    assert!(!found.all_below(limit_hz), "{:?}", found.freqs_hz);
+    assert!(
+        settings.modes > 2 && settings.modes.is_power_of_two(),
+        "{}",
+        settings.modes
+    );
+    let below = found.freqs_hz.iter().filter(|&&f| f < limit_hz).count();
+    assert!(
+        below < settings.modes,
+        "{below} below, {} sought",
+        settings.modes
+    );
+    // Half as many would not have reached the limit.
+    let half = solve(&bar, 1000, vec![], settings.modes / 2);
+    assert!(half.all_below(limit_hz), "{:?}", half.freqs_hz);
+    for (k, (a, b)) in half.freqs_hz.iter().zip(&found.freqs_hz).enumerate() {
+        assert!((a / b - 1.0).abs() < 1e-6, "mode {k}: {a} vs {b} Hz");
+    }
 }

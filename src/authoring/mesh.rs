@@ -32,7 +32,7 @@ use std::time::{Duration, Instant};
 
 pub use error::{scale_hint, unit_warning, MeshError};
 pub use lanczos::SolveStage;
-pub use matching::{combine_with_recording, MatchReport};
+pub use matching::{combine_with_recording, match_recording, MatchReport};
 pub use read::{parse_surface, write_obj};
 pub use strike::{spread_strike_points, strike_points, StrikePoint, StrikeRequest};
 pub use surface::Surface;
@@ -182,6 +182,27 @@ pub fn solve_modes(
     progress: &mut dyn FnMut(MeshStage),
 ) -> Result<MeshModes, MeshError> {
     solve_modes_within(surface, settings, DEFAULT_MAX_SOLVE_BYTES, progress)
+}
+
+/// The modes of `surface` up to `max_hz`: solved for `settings.modes`, then again for twice as
+/// many until one lies at or above `max_hz`, the solid has no more, or [`MAX_MODES`] are found
+/// (then every mode found may lie below `max_hz`: see [`MeshModes::all_below`]).
+/// `settings.modes` is left at the count last solved for.
+pub fn solve_modes_up_to(
+    surface: &Surface,
+    settings: &mut MeshSettings,
+    max_hz: f64,
+    max_bytes: usize,
+    progress: &mut dyn FnMut(MeshStage),
+) -> Result<MeshModes, MeshError> {
+    loop {
+        let modes = solve_modes_within(surface, settings, max_bytes, progress)?;
+        let exhausted = modes.freqs_hz.len() < settings.modes;
+        if !modes.all_below(max_hz) || exhausted || settings.modes >= MAX_MODES {
+            return Ok(modes);
+        }
+        settings.modes = (2 * settings.modes).min(MAX_MODES);
+    }
 }
 
 /// The lowest vibration modes of the solid bounded by `surface` (checked here); a solve that
@@ -367,6 +388,11 @@ impl MeshModes {
         (0..3)
             .map(|a| v.size_m[a] * v.dims[a] as f64)
             .fold(0.0, f64::max)
+    }
+
+    /// Whether every mode found lies below `limit_hz` (none found counts as not).
+    pub fn all_below(&self, limit_hz: f64) -> bool {
+        self.freqs_hz.last().is_some_and(|&f| f < limit_hz)
     }
 
     /// A warning when the motions left out as rigid are not near zero (above 1 % of the lowest

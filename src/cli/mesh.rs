@@ -5,19 +5,18 @@ use std::path::PathBuf;
 use clap::Args;
 use sha2::{Digest, Sha256};
 
-use modal_resonator::authoring::fit::{
-    fit_bank_with_progress, read_wav_recording, FitOptions, Recording,
-};
+use modal_resonator::authoring::fit::{read_wav_recording, Recording};
 use modal_resonator::authoring::materials::Material;
 use modal_resonator::authoring::mesh::strike::spread_names;
 use modal_resonator::authoring::mesh::{
-    bank_from_modes, check_elements, combine_with_recording, parse_surface, solve_modes_within,
-    spread_strike_points, strike_points, unit_warning, Clamp, MeshError, MeshModes, MeshSettings,
-    MeshSource, MeshStage, SolveStage, StrikePoint, StrikeRequest, Surface, DEFAULT_ELEMENTS,
-    DEFAULT_MAX_SOLVE_BYTES, MAX_MODES,
+    bank_from_modes, check_elements, match_recording, parse_surface, solve_modes_up_to,
+    solve_modes_within, spread_strike_points, strike_points, unit_warning, Clamp, MeshError,
+    MeshModes, MeshSettings, MeshSource, MeshStage, SolveStage, StrikePoint, StrikeRequest,
+    Surface, DEFAULT_ELEMENTS, DEFAULT_MAX_SOLVE_BYTES, MAX_MODES,
 };
 use modal_resonator::authoring::shapes::{ModeLimits, MAX_AUDIBLE_HZ};
 use modal_resonator::bank::summary::note_name;
+use modal_resonator::bank::validate::MAX_POSITIONS;
 
 use super::progress::Progress;
 use super::shape::{parse_loss_factor, parse_material, parse_positive};
@@ -216,8 +215,10 @@ fn point_plan(args: &MeshArgs, surface: &Surface) -> Result<PointPlan, String> {
         return Ok(PointPlan::Spread(DEFAULT_POINTS));
     };
     match text.trim().parse::<usize>() {
-        Ok(count) if (1..=64).contains(&count) => Ok(PointPlan::Spread(count)),
-        Ok(count) => Err(format!("--positions {count}: expected 1 to 64 points")),
+        Ok(count) if (1..=MAX_POSITIONS).contains(&count) => Ok(PointPlan::Spread(count)),
+        Ok(count) => Err(format!(
+            "--positions {count}: expected 1 to {MAX_POSITIONS} points"
+        )),
         Err(_) => Ok(PointPlan::Given(strike_points(
             surface,
             &parse_points(text, args.scale)?,
@@ -278,60 +279,29 @@ fn recording_point(
             names.join(", ")
         )
     })?;
-    if names.len() >= 64 {
-        return Err("--match: a bank has at most 64 positions".to_string());
+    if names.len() >= MAX_POSITIONS {
+        return Err(format!(
+            "--match: a bank has at most {MAX_POSITIONS} positions"
+        ));
     }
     let recording = read(&request[0].name)?;
     let point = strike_points(surface, &request).remove(0);
     Ok((recording, RecordedAt::Added(point), file_name))
 }
 
-/// `bank` combined with `recording` (of the file `file_name`), struck at position `at`.
+/// `bank` matched to `recording` (of the file `file_name`), struck at position `at`, with a
+/// progress bar.
 fn matched(
     bank: modal_resonator::bank::Bank,
     recording: &Recording,
     at: usize,
     file_name: &str,
 ) -> Result<modal_resonator::bank::Bank, String> {
-    let name = bank.positions[at].name.clone();
-    let options = FitOptions {
-        name: bank.name.clone(),
-        ..FitOptions::default()
-    };
     let mut progress = Progress::new("fitting the recording");
-    let fit = fit_bank_with_progress(std::slice::from_ref(recording), &options, |done| {
-        progress.set(done)
-    });
+    let matched = match_recording(&bank, recording, at, file_name, |done| progress.set(done));
     progress.finish();
-    let fitted = fit.map_err(|e| format!("{}: {e}", recording.origin))?.bank;
-    let (mut combined, report) = combine_with_recording(&bank, &fitted.modes, at);
-    if let Some(source) = combined.source.as_mut() {
-        source.insert(
-            "matched_recording".into(),
-            serde_json::json!({
-                "file": file_name,
-                "position": name,
-                "frequency_scale": report.frequency_scale,
-                "scale_change_per_octave": report.scale_per_octave,
-                "paired_modes": report.paired,
-                "unpaired_recorded_modes": report.unpaired_recorded,
-                "mesh_modes_kept": report.kept_from_mesh,
-                "mesh_modes_dropped": report.dropped_from_mesh,
-            }),
-        );
-    }
-    combined.description = format!(
-        "{} Matched to a recording struck at \"{name}\": {} modes paired (mesh frequencies x \
-         {:.4} at the lowest), {} recorded modes unpaired, {} mesh modes the recording could not \
-         hear kept, {} it should have heard left out.",
-        combined.description,
-        report.paired,
-        report.frequency_scale,
-        report.unpaired_recorded,
-        report.kept_from_mesh,
-        report.dropped_from_mesh
-    );
-    Ok(combined)
+    let (bank, _) = matched.map_err(|e| format!("{}: {e}", recording.origin))?;
+    Ok(bank)
 }
 
 /// The surface in metres, and what the bank records of its file.
@@ -367,32 +337,25 @@ fn read_mesh(args: &MeshArgs) -> Result<(Surface, MeshSource), String> {
 }
 
 /// The modes of `surface`: as many as `settings` asks, or, with `--max-hz` and no `--modes`,
-/// solved again with twice as many until one lies at or above the limit (or 500 are found).
+/// up to that frequency (at most the library's limit, said when reached).
 fn solve_up_to_limit(
     args: &MeshArgs,
     surface: &Surface,
     settings: &mut MeshSettings,
 ) -> Result<MeshModes, String> {
     let place = args.input.display().to_string();
-    loop {
-        let modes = solve_with_progress(surface, settings).map_err(|e| format!("{place}: {e}"))?;
-        let Some(limit) = args.max_hz.filter(|_| args.modes.is_none()) else {
-            return Ok(modes);
-        };
-        let reached = modes.freqs_hz.last().is_none_or(|&f| f >= limit);
-        let exhausted = modes.freqs_hz.len() < settings.modes;
-        if reached || exhausted {
-            return Ok(modes);
-        }
-        if settings.modes >= MAX_MODES {
+    let limit = args.max_hz.filter(|_| args.modes.is_none());
+    let modes =
+        solve_with_progress(surface, settings, limit).map_err(|e| format!("{place}: {e}"))?;
+    if let Some(limit) = limit.filter(|&limit| modes.all_below(limit)) {
+        if modes.freqs_hz.len() >= MAX_MODES {
             eprintln!(
                 "{place}: all {MAX_MODES} modes found lie below --max-hz {limit} Hz; the bank keeps \
                  the lowest {MAX_MODES}"
             );
-            return Ok(modes);
         }
-        settings.modes = (2 * settings.modes).min(MAX_MODES);
     }
+    Ok(modes)
 }
 
 /// Parses `--modes`.
@@ -437,8 +400,12 @@ fn memory_limit_bytes() -> usize {
     })
 }
 
-/// Solves with a progress bar for each stage.
-fn solve_with_progress(surface: &Surface, settings: &MeshSettings) -> Result<MeshModes, MeshError> {
+/// Solves (up to `max_hz` when given) with a progress bar for each stage.
+fn solve_with_progress(
+    surface: &Surface,
+    settings: &mut MeshSettings,
+    max_hz: Option<f64>,
+) -> Result<MeshModes, MeshError> {
     let mut bar: Option<(&'static str, Progress)> = None;
     let mut stage_bar = |label: &'static str, done: f64| {
         if bar.as_ref().is_none_or(|(l, _)| *l != label) {
@@ -452,14 +419,18 @@ fn solve_with_progress(surface: &Surface, settings: &MeshSettings) -> Result<Mes
         }
     };
     let limit = memory_limit_bytes();
-    let modes = solve_modes_within(surface, settings, limit, &mut |stage| match stage {
+    let mut on_stage = |stage| match stage {
         MeshStage::Voxelising => stage_bar("voxelising", 0.0),
         MeshStage::Assembling { .. } => stage_bar("assembling", 0.0),
         MeshStage::Solving(SolveStage::Factorising) => stage_bar("factorising", 0.0),
         MeshStage::Solving(SolveStage::Iterating { steps, expected }) => {
             stage_bar("iterating", steps as f64 / expected.max(1) as f64)
         }
-    });
+    };
+    let modes = match max_hz {
+        Some(max_hz) => solve_modes_up_to(surface, settings, max_hz, limit, &mut on_stage),
+        None => solve_modes_within(surface, settings, limit, &mut on_stage),
+    };
     if let Some((_, progress)) = bar {
         progress.finish();
     }
@@ -504,9 +475,9 @@ fn parse_points(text: &str, scale: f64) -> Result<Vec<StrikeRequest>, String> {
             return Err(format!("--positions: \"{}\" is named twice", p.name));
         }
     }
-    if points.is_empty() || points.len() > 64 {
+    if points.is_empty() || points.len() > MAX_POSITIONS {
         return Err(format!(
-            "--positions: expected 1 to 64 points, found {}",
+            "--positions: expected 1 to {MAX_POSITIONS} points, found {}",
             points.len()
         ));
     }

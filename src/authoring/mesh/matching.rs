@@ -13,6 +13,7 @@
 //! 000 section 6.2.3). A mesh mode silent at the recorded point, which the recording could not
 //! have heard, is kept at the mesh's frequency times the scale, at the level the pairs set.
 
+use crate::authoring::fit::{fit_bank_with_progress, FitError, FitOptions, Recording};
 use crate::bank::{Bank, Mode};
 
 /// Most a paired recorded mode may lie from its mesh mode, after the common scale, as a ratio.
@@ -204,52 +205,65 @@ fn pairs(mesh: &Bank, recorded: &[Mode], at: usize, line: ScaleLine) -> Vec<(usi
     pairs
 }
 
+/// `bank` matched to `recording` of the object struck at the bank's position `at`: the
+/// recording fitted ([`fit_bank_with_progress`], reporting its progress from 0 to 1), its modes
+/// combined with the bank's ([`combine_with_recording`]), and what was done written into the
+/// bank: `source.matched_recording` (the recording's file name `file_name`, the position and the
+/// [`MatchReport`]) and a sentence of the description.
+pub fn match_recording(
+    bank: &Bank,
+    recording: &Recording,
+    at: usize,
+    file_name: &str,
+    progress: impl FnMut(f64),
+) -> Result<(Bank, MatchReport), FitError> {
+    let options = FitOptions {
+        name: bank.name.clone(),
+        ..FitOptions::default()
+    };
+    let fitted = fit_bank_with_progress(std::slice::from_ref(recording), &options, progress)?.bank;
+    let (mut combined, report) = combine_with_recording(bank, &fitted.modes, at);
+    let name = &bank.positions[at].name;
+    if let Some(source) = combined.source.as_mut() {
+        source.insert(
+            "matched_recording".into(),
+            serde_json::json!({
+                "file": file_name,
+                "position": name,
+                "frequency_scale": report.frequency_scale,
+                "scale_change_per_octave": report.scale_per_octave,
+                "paired_modes": report.paired,
+                "unpaired_recorded_modes": report.unpaired_recorded,
+                "mesh_modes_kept": report.kept_from_mesh,
+                "mesh_modes_dropped": report.dropped_from_mesh,
+            }),
+        );
+    }
+    combined.description = format!(
+        "{} Matched to a recording struck at \"{name}\": {} modes paired (mesh frequencies x \
+         {:.4} at the lowest), {} recorded modes unpaired, {} mesh modes the recording could not \
+         hear kept, {} it should have heard left out.",
+        combined.description,
+        report.paired,
+        report.frequency_scale,
+        report.unpaired_recorded,
+        report.kept_from_mesh,
+        report.dropped_from_mesh
+    );
+    Ok((combined, report))
+}
+
 /// `mesh` combined with `recorded`, modes fitted from a recording of the object struck at the
 /// mesh bank's position `at` (each with one gain). The positions are the mesh bank's.
 pub fn combine_with_recording(mesh: &Bank, recorded: &[Mode], at: usize) -> (Bank, MatchReport) {
-    let positions = mesh.positions.len();
-    let scale = frequency_scale(mesh, recorded, at);
-    let first = pairs(mesh, recorded, at, ScaleLine::constant(scale));
-    let (line, pairs) = match ScaleLine::fit(mesh, recorded, &first) {
-        Some(line) => {
-            let second = pairs(mesh, recorded, at, line);
-            if second.len() >= first.len() {
-                (line, second)
-            } else {
-                (ScaleLine::constant(scale), first)
-            }
-        }
-        None => (ScaleLine::constant(scale), first),
-    };
-    let floor = 10f64.powf(EXCITED_DB / 20.0);
-    let mut modes = Vec::new();
-    let mut levels = Vec::new();
-    for &(k, j) in &pairs {
-        let (r, m) = (&recorded[k], &mesh.modes[j]);
-        let at_point = m.gains[at];
-        // Never divide by less than the excitation floor: a point near a node of the mode.
-        let reference = at_point.signum() * at_point.abs().max(floor * largest(m));
-        let gains = (0..positions)
-            .map(|p| {
-                if p == at {
-                    r.gains[0]
-                } else {
-                    r.gains[0] * m.gains[p] / reference
-                }
-            })
-            .collect();
-        levels.push(r.gains[0].abs() / at_point.abs());
-        modes.push(Mode {
-            freq_hz: r.freq_hz,
-            decay_per_s: r.decay_per_s,
-            gains,
-        });
-    }
+    let (line, pairs) = best_pairs(mesh, recorded, at);
+    let (mut modes, levels) = paired_modes(mesh, recorded, at, &pairs);
     let paired_recorded: Vec<usize> = pairs.iter().map(|&(k, _)| k).collect();
     let unpaired: Vec<&Mode> = (0..recorded.len())
         .filter(|k| !paired_recorded.contains(k))
         .map(|k| &recorded[k])
         .collect();
+    let positions = mesh.positions.len();
     for r in &unpaired {
         modes.push(Mode {
             freq_hz: r.freq_hz,
@@ -257,26 +271,9 @@ pub fn combine_with_recording(mesh: &Bank, recorded: &[Mode], at: usize) -> (Ban
             gains: vec![r.gains[0]; positions],
         });
     }
-    levels.sort_by(f64::total_cmp);
-    let level = levels.get(levels.len() / 2).copied().unwrap_or(0.0);
-    let (mut kept, mut dropped) = (0, 0);
-    let paired_mesh: Vec<usize> = pairs.iter().map(|&(_, j)| j).collect();
-    for (j, m) in mesh.modes.iter().enumerate() {
-        if paired_mesh.contains(&j) {
-            continue;
-        }
-        if excited(m, at) || level == 0.0 {
-            dropped += 1; // the recording should hold it, and does not
-            continue;
-        }
-        kept += 1;
-        let s = line.scale(m.freq_hz);
-        modes.push(Mode {
-            freq_hz: m.freq_hz * s,
-            decay_per_s: m.decay_per_s * s,
-            gains: m.gains.iter().map(|g| g * level).collect(),
-        });
-    }
+    let (unheard, dropped) = unheard_mesh_modes(mesh, at, &pairs, line, levels);
+    let kept = unheard.len();
+    modes.extend(unheard);
     modes.sort_by(|a, b| a.freq_hz.total_cmp(&b.freq_hz));
     let mut bank = mesh.clone();
     bank.modes = modes;
@@ -296,4 +293,89 @@ pub fn combine_with_recording(mesh: &Bank, recorded: &[Mode], at: usize) -> (Ban
         dropped_from_mesh: dropped,
     };
     (bank, report)
+}
+
+/// The pairs (recorded mode, mesh mode) of the better of two passes, with the frequency ratio
+/// they were paired around: one constant scale, then a ratio drifting with frequency fitted to
+/// the first pass's pairs, kept if it pairs at least as many.
+fn best_pairs(mesh: &Bank, recorded: &[Mode], at: usize) -> (ScaleLine, Vec<(usize, usize)>) {
+    let constant = ScaleLine::constant(frequency_scale(mesh, recorded, at));
+    let first = pairs(mesh, recorded, at, constant);
+    if let Some(line) = ScaleLine::fit(mesh, recorded, &first) {
+        let second = pairs(mesh, recorded, at, line);
+        if second.len() >= first.len() {
+            return (line, second);
+        }
+    }
+    (constant, first)
+}
+
+/// The paired modes: the recording's frequency, decay and gain at the recorded point `at`, the
+/// mesh's gain ratio to that point elsewhere; and for each pair the recorded level over the
+/// mesh's at the point.
+fn paired_modes(
+    mesh: &Bank,
+    recorded: &[Mode],
+    at: usize,
+    pairs: &[(usize, usize)],
+) -> (Vec<Mode>, Vec<f64>) {
+    let floor = 10f64.powf(EXCITED_DB / 20.0);
+    let mut modes = Vec::with_capacity(pairs.len());
+    let mut levels = Vec::with_capacity(pairs.len());
+    for &(k, j) in pairs {
+        let (r, m) = (&recorded[k], &mesh.modes[j]);
+        let at_point = m.gains[at];
+        // Never divide by less than the excitation floor: a point near a node of the mode.
+        let reference = at_point.signum() * at_point.abs().max(floor * largest(m));
+        let gains = (0..mesh.positions.len())
+            .map(|p| {
+                if p == at {
+                    r.gains[0]
+                } else {
+                    r.gains[0] * m.gains[p] / reference
+                }
+            })
+            .collect();
+        levels.push(r.gains[0].abs() / at_point.abs());
+        modes.push(Mode {
+            freq_hz: r.freq_hz,
+            decay_per_s: r.decay_per_s,
+            gains,
+        });
+    }
+    (modes, levels)
+}
+
+/// The unpaired mesh modes the recorded point `at` cannot excite, which the recording could not
+/// have heard: kept at the mesh's frequency times the scale `line`, at the median of the pairs'
+/// `levels`. Also how many unpaired mesh modes the point does excite, left out (the recording
+/// should hold them, and does not).
+fn unheard_mesh_modes(
+    mesh: &Bank,
+    at: usize,
+    pairs: &[(usize, usize)],
+    line: ScaleLine,
+    mut levels: Vec<f64>,
+) -> (Vec<Mode>, usize) {
+    levels.sort_by(f64::total_cmp);
+    let level = levels.get(levels.len() / 2).copied().unwrap_or(0.0);
+    let paired_mesh: Vec<usize> = pairs.iter().map(|&(_, j)| j).collect();
+    let mut kept = Vec::new();
+    let mut dropped = 0;
+    for (j, m) in mesh.modes.iter().enumerate() {
+        if paired_mesh.contains(&j) {
+            continue;
+        }
+        if excited(m, at) || level == 0.0 {
+            dropped += 1;
+            continue;
+        }
+        let s = line.scale(m.freq_hz);
+        kept.push(Mode {
+            freq_hz: m.freq_hz * s,
+            decay_per_s: m.decay_per_s * s,
+            gains: m.gains.iter().map(|g| g * level).collect(),
+        });
+    }
+    (kept, dropped)
 }
