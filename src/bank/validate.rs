@@ -12,7 +12,7 @@ mod json;
 use std::collections::HashMap;
 use std::fmt;
 
-use super::format::{Bank, FORMAT_NAME, FORMAT_VERSION};
+use super::format::{Bank, BankDefaults, FORMAT_NAME, FORMAT_VERSION};
 
 pub(crate) use json::check_document;
 
@@ -180,10 +180,18 @@ pub(crate) fn check_bank(bank: &Bank, problems: &mut Problems) {
     if let Some(root_hz) = bank.root_hz {
         problems.check(&root.field("root_hz"), check_number(root_hz, &FREQ_HZ));
     }
+    check_positions(bank, &root.field("positions"), problems);
+    check_modes(bank, &root.field("modes"), problems);
+    if let Some(defaults) = &bank.defaults {
+        check_defaults(defaults, &root.field("defaults"), problems);
+    }
+}
 
-    let positions_path = root.field("positions");
+/// The positions, at `positions_path`: how many, their names (unique), their coordinates (as
+/// many for each).
+fn check_positions(bank: &Bank, positions_path: &JsonPath<'_>, problems: &mut Problems) {
     problems.check(
-        &positions_path,
+        positions_path,
         check_count(bank.positions.len(), MAX_POSITIONS, "positions"),
     );
     let mut names = UniqueNames::default();
@@ -199,10 +207,12 @@ pub(crate) fn check_bank(bank: &Bank, problems: &mut Problems) {
             problems.check(&coords_path.index(j), check_number(coord, &COORD));
         }
     }
+}
 
-    let modes_path = root.field("modes");
+/// The modes, at `modes_path`: how many, their numbers, and a gain for each position.
+fn check_modes(bank: &Bank, modes_path: &JsonPath<'_>, problems: &mut Problems) {
     problems.check(
-        &modes_path,
+        modes_path,
         check_count(bank.modes.len(), MAX_MODES, "modes"),
     );
     for (i, mode) in bank.modes.iter().enumerate() {
@@ -224,35 +234,35 @@ pub(crate) fn check_bank(bank: &Bank, problems: &mut Problems) {
             problems.check(&gains_path.index(j), check_number(gain, &GAIN));
         }
     }
+}
 
-    if let Some(defaults) = &bank.defaults {
-        let values = [
-            defaults.material_q,
-            defaults.damping_tilt,
-            defaults.hardness_ms,
-            defaults.strike_position,
-            defaults.key_tracking_pct,
-            defaults.roughness,
-            defaults.rolling_radius_mm,
-            defaults.contact_speed_m_per_s,
-            defaults.contact_force,
-        ];
-        let path = root.field("defaults");
-        for ((name, range), value) in DEFAULTS_RANGES.iter().zip(values) {
-            if let Some(value) = value {
-                problems.check(&path.field(name), check_number(value, range));
-            }
+/// The defaults, at `path`: each number in its range, the exciter one the engine has.
+fn check_defaults(defaults: &BankDefaults, path: &JsonPath<'_>, problems: &mut Problems) {
+    let values = [
+        defaults.material_q,
+        defaults.damping_tilt,
+        defaults.hardness_ms,
+        defaults.strike_position,
+        defaults.key_tracking_pct,
+        defaults.roughness,
+        defaults.rolling_radius_mm,
+        defaults.contact_speed_m_per_s,
+        defaults.contact_force,
+    ];
+    for ((name, range), value) in DEFAULTS_RANGES.iter().zip(values) {
+        if let Some(value) = value {
+            problems.check(&path.field(name), check_number(value, range));
         }
-        if let Some(exciter) = &defaults.exciter {
-            if !EXCITER_NAMES.contains(&exciter.as_str()) {
-                problems.check(
-                    &path.field("exciter"),
-                    Err(format!(
-                        "expected one of {}, found \"{exciter}\"",
-                        EXCITER_NAMES.join(", ")
-                    )),
-                );
-            }
+    }
+    if let Some(exciter) = &defaults.exciter {
+        if !EXCITER_NAMES.contains(&exciter.as_str()) {
+            problems.check(
+                &path.field("exciter"),
+                Err(format!(
+                    "expected one of {}, found \"{exciter}\"",
+                    EXCITER_NAMES.join(", ")
+                )),
+            );
         }
     }
 }
