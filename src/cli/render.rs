@@ -172,70 +172,93 @@ fn render_output(
 ) -> Result<RenderSummary, String> {
     let mut settings = settings.clone();
     let (scale, first_share) = match args.normalize {
-        Some(peak_dbfs) => {
-            let target = 10f32.powf(peak_dbfs / 20.0);
-            let mut peak_of = |settings: &RenderSettings, from: f64| {
-                let quiet = |_: &[f32], _: &[f32]| Ok::<(), Infallible>(());
-                let share = |d: f64| from + 0.25 * d;
-                let Ok(pass) = render_to(
-                    bank,
-                    score,
-                    settings,
-                    1.0,
-                    |d| progress.set(share(d)),
-                    quiet,
-                );
-                pass.peak
-            };
-            let mut peak = peak_of(&settings, 0.0);
-            // Modes stop at the truncation threshold before the scaling: a render to be raised
-            // stops them as far lower (down to the lowest threshold), or its tail would end in an
-            // audible cut; its peak is measured again with that threshold, since more modes
-            // start under it.
-            if peak > 0.0 && target > peak {
-                let lowest = control_range("truncation_db").0;
-                let lowered =
-                    (settings.controls.truncation_db - gain_to_db(target / peak)).max(lowest);
-                if lowered < settings.controls.truncation_db {
-                    settings.controls.truncation_db = lowered;
-                    peak = peak_of(&settings, 0.25);
-                }
-            }
-            (if peak > 0.0 { target / peak } else { 1.0 }, 0.5)
-        }
+        Some(peak_dbfs) => (
+            normalizing_scale(bank, score, &mut settings, peak_dbfs, progress),
+            0.5,
+        ),
         None => (1.0, 0.0),
     };
     let settings = &settings;
     let share = |done: f64| first_share + (1.0 - first_share) * done;
-    if args.output.as_os_str() != STDOUT {
-        let mut file =
-            WavFile::create(&args.output, args.bits, args.rate).map_err(|e| e.to_string())?;
-        let rendered = render_to(
+    if args.output.as_os_str() == STDOUT {
+        return render_to_stdout(args, bank, score, settings, scale, |d| {
+            progress.set(share(d))
+        });
+    }
+    let mut file =
+        WavFile::create(&args.output, args.bits, args.rate).map_err(|e| e.to_string())?;
+    let rendered = render_to(
+        bank,
+        score,
+        settings,
+        scale,
+        |d| progress.set(share(d)),
+        |l, r| file.write(l, r),
+    )
+    .map_err(|e| e.to_string())?;
+    file.finish().map_err(|e| e.to_string())?;
+    Ok(rendered)
+}
+
+/// The gain that brings the render's peak to `peak_dbfs`, measured by rendering it (progress
+/// 0 to 0.5). Modes stop at the truncation threshold before the scaling: a render to be raised
+/// stops them as far lower in `settings` (down to the lowest threshold), or its tail would end
+/// in an audible cut; its peak is measured again with that threshold, since more modes start
+/// under it.
+fn normalizing_scale(
+    bank: &Arc<PreparedBank>,
+    score: Score,
+    settings: &mut RenderSettings,
+    peak_dbfs: f32,
+    progress: &mut Progress,
+) -> f32 {
+    let target = 10f32.powf(peak_dbfs / 20.0);
+    let mut peak_of = |settings: &RenderSettings, from: f64| {
+        let quiet = |_: &[f32], _: &[f32]| Ok::<(), Infallible>(());
+        let share = |d: f64| from + 0.25 * d;
+        let Ok(pass) = render_to(
             bank,
             score,
             settings,
-            scale,
+            1.0,
             |d| progress.set(share(d)),
-            |l, r| file.write(l, r),
-        )
-        .map_err(|e| e.to_string())?;
-        file.finish().map_err(|e| e.to_string())?;
-        return Ok(rendered);
+            quiet,
+        );
+        pass.peak
+    };
+    let mut peak = peak_of(settings, 0.0);
+    if peak > 0.0 && target > peak {
+        let lowest = control_range("truncation_db").0;
+        let lowered = (settings.controls.truncation_db - gain_to_db(target / peak)).max(lowest);
+        if lowered < settings.controls.truncation_db {
+            settings.controls.truncation_db = lowered;
+            peak = peak_of(settings, 0.25);
+        }
     }
+    if peak > 0.0 {
+        target / peak
+    } else {
+        1.0
+    }
+}
+
+/// Renders the whole WAV in memory and writes it to standard output (a pipe cannot be
+/// rewound to patch the header's sizes).
+fn render_to_stdout(
+    args: &RenderArgs,
+    bank: &Arc<PreparedBank>,
+    score: Score,
+    settings: &RenderSettings,
+    scale: f32,
+    progress: impl FnMut(f64),
+) -> Result<RenderSummary, String> {
     let (mut left, mut right) = (Vec::new(), Vec::new());
     let collect = |l: &[f32], r: &[f32]| {
         left.extend_from_slice(l);
         right.extend_from_slice(r);
         Ok::<(), Infallible>(())
     };
-    let Ok(rendered) = render_to(
-        bank,
-        score,
-        settings,
-        scale,
-        |d| progress.set(share(d)),
-        collect,
-    );
+    let Ok(rendered) = render_to(bank, score, settings, scale, progress, collect);
     let whole = Rendered {
         left,
         right,
