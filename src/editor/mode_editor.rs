@@ -28,80 +28,99 @@ pub fn show(
         return;
     };
     ui.label(RichText::new(format!("Mode {} of {}", i + 1, session.num_modes())).strong());
-    let mode = session.bank().modes[i].clone();
     Grid::new("mode editor")
         .num_columns(2)
         .spacing([8.0, 4.0])
         .show(ui, |ui| {
-            ui.label("Frequency");
-            let mut freq_hz = mode.freq_hz;
-            let speed = (freq_hz * 0.002).max(0.01);
-            let response = ui.add(
-                DragValue::new(&mut freq_hz)
-                    .speed(speed)
-                    .range(1.0..=1e6)
-                    .max_decimals(3)
-                    .suffix(" Hz"),
-            );
-            if response.changed() {
-                session.set_freq_hz(i, freq_hz);
-            }
-            ui.end_row();
-
-            ui.label("Note");
-            ui.label(note_name(session.bank().modes[i].freq_hz));
-            ui.end_row();
-
-            ui.label("T60");
-            if mode.decay_per_s > 0.0 {
-                let mut t60_s = decay_to_t60_s(mode.decay_per_s);
-                let speed = (t60_s * 0.005).max(0.0005);
-                let response = ui.add(
-                    DragValue::new(&mut t60_s)
-                        .speed(speed)
-                        .range(MIN_EDIT_T60_S..=MAX_EDIT_T60_S)
-                        .max_decimals(4)
-                        .suffix(" s"),
-                );
-                if response.changed() {
-                    session.set_decay_per_s(i, t60_to_decay(t60_s));
-                }
-            } else if ui
-                .button("690 s (decay 0 plays at the engine's floor): set 10 s")
-                .clicked()
-            {
-                session.set_decay_per_s(i, t60_to_decay(10.0));
-            }
-            ui.end_row();
-
-            ui.label("Gain at strike");
-            let gain = session.gain_at(i, weights);
-            let mut gain_db = 20.0 * gain.abs().max(1e-9).log10();
-            let response = ui.add(
-                DragValue::new(&mut gain_db)
-                    .speed(0.1)
-                    .range(GAIN_DB_RANGE.0..=GAIN_DB_RANGE.1)
-                    .max_decimals(2)
-                    .suffix(" dB"),
-            );
-            if response.changed() {
-                let sign = if gain < 0.0 { -1.0 } else { 1.0 };
-                session.set_gain_at(i, weights, sign * 10f64.powf(gain_db / 20.0));
-            }
-            ui.end_row();
-
-            ui.label("Polarity");
-            let label = if gain < 0.0 {
-                "inverted (−)"
-            } else {
-                "normal (+)"
-            };
-            if ui.button(label).on_hover_text("Flip the sign").clicked() {
-                session.set_gain_at(i, weights, -gain);
-                session.end_gesture();
-            }
-            ui.end_row();
+            frequency_rows(ui, session, i);
+            t60_row(ui, session, i);
+            gain_rows(ui, session, i, weights);
         });
+    mute_solo_row(ui, session, i);
+    mutes_row(ui, session);
+}
+
+/// Mode `i`'s frequency, to drag, and the note it is nearest.
+fn frequency_rows(ui: &mut Ui, session: &mut BankSession, i: usize) {
+    ui.label("Frequency");
+    let mut freq_hz = session.bank().modes[i].freq_hz;
+    let speed = (freq_hz * 0.002).max(0.01);
+    let response = ui.add(
+        DragValue::new(&mut freq_hz)
+            .speed(speed)
+            .range(1.0..=1e6)
+            .max_decimals(3)
+            .suffix(" Hz"),
+    );
+    if response.changed() {
+        session.set_freq_hz(i, freq_hz);
+    }
+    ui.end_row();
+
+    ui.label("Note");
+    ui.label(note_name(session.bank().modes[i].freq_hz));
+    ui.end_row();
+}
+
+/// Mode `i`'s T60, to drag; a mode that does not decay offers a finite one instead.
+fn t60_row(ui: &mut Ui, session: &mut BankSession, i: usize) {
+    ui.label("T60");
+    let decay_per_s = session.bank().modes[i].decay_per_s;
+    if decay_per_s > 0.0 {
+        let mut t60_s = decay_to_t60_s(decay_per_s);
+        let speed = (t60_s * 0.005).max(0.0005);
+        let response = ui.add(
+            DragValue::new(&mut t60_s)
+                .speed(speed)
+                .range(MIN_EDIT_T60_S..=MAX_EDIT_T60_S)
+                .max_decimals(4)
+                .suffix(" s"),
+        );
+        if response.changed() {
+            session.set_decay_per_s(i, t60_to_decay(t60_s));
+        }
+    } else if ui
+        .button("690 s (decay 0 plays at the engine's floor): set 10 s")
+        .clicked()
+    {
+        session.set_decay_per_s(i, t60_to_decay(10.0));
+    }
+    ui.end_row();
+}
+
+/// Mode `i`'s gain where the strike is (`weights`), in dB to drag, and its polarity to flip.
+fn gain_rows(ui: &mut Ui, session: &mut BankSession, i: usize, weights: &PositionWeights) {
+    ui.label("Gain at strike");
+    let gain = session.gain_at(i, weights);
+    let mut gain_db = 20.0 * gain.abs().max(1e-9).log10();
+    let response = ui.add(
+        DragValue::new(&mut gain_db)
+            .speed(0.1)
+            .range(GAIN_DB_RANGE.0..=GAIN_DB_RANGE.1)
+            .max_decimals(2)
+            .suffix(" dB"),
+    );
+    if response.changed() {
+        let sign = if gain < 0.0 { -1.0 } else { 1.0 };
+        session.set_gain_at(i, weights, sign * 10f64.powf(gain_db / 20.0));
+    }
+    ui.end_row();
+
+    ui.label("Polarity");
+    let label = if gain < 0.0 {
+        "inverted (−)"
+    } else {
+        "normal (+)"
+    };
+    if ui.button(label).on_hover_text("Flip the sign").clicked() {
+        session.set_gain_at(i, weights, -gain);
+        session.end_gesture();
+    }
+    ui.end_row();
+}
+
+/// Mute and solo buttons of mode `i`.
+fn mute_solo_row(ui: &mut Ui, session: &mut BankSession, i: usize) {
     ui.horizontal(|ui| {
         if ui
             .selectable_label(session.is_muted(i), "Mute")
@@ -118,7 +137,6 @@ pub fn show(
             session.toggle_solo(i);
         }
     });
-    mutes_row(ui, session);
 }
 
 /// How many modes are muted or soloed, and a button to clear them.
