@@ -3,12 +3,29 @@
 
 use super::surface::Surface;
 
-/// The surfaces behind the meshed factory banks, by their file in `presets/meshes/`
-/// (`tests/mesh_presets.rs` checks each file against its generator).
-pub const FACTORY_MESHES: [(&str, fn() -> Surface); 3] = [
-    ("cup.obj", cup),
-    ("tuning-fork.obj", tuning_fork),
-    ("bell.obj", bell),
+/// A surface behind a meshed factory bank: its file and the code that makes it.
+pub struct FactoryMesh {
+    /// File name in `presets/meshes/`.
+    pub file: &'static str,
+    /// The generator.
+    pub surface: fn() -> Surface,
+}
+
+/// The surfaces behind the meshed factory banks (`tests/mesh_presets.rs` checks each file
+/// against its generator).
+pub const FACTORY_MESHES: [FactoryMesh; 3] = [
+    FactoryMesh {
+        file: "cup.obj",
+        surface: cup,
+    },
+    FactoryMesh {
+        file: "tuning-fork.obj",
+        surface: tuning_fork,
+    },
+    FactoryMesh {
+        file: "bell.obj",
+        surface: bell,
+    },
 ];
 
 /// A box from the origin to `size_m`, faces outward.
