@@ -168,6 +168,11 @@ impl Bank {
 const ROOT_STRENGTH_DB: f64 = 6.0;
 
 impl Bank {
+    /// The text `source` holds under `key`, if it holds text there.
+    pub fn source_text(&self, key: &str) -> Option<&str> {
+        self.source.as_ref()?.get(key)?.as_str()
+    }
+
     /// The pitch the bank sounds at size 1: `root_hz` when given, else the lowest of the modes
     /// within 6 dB of the strongest (strength: largest gain over the positions).
     pub fn effective_root_hz(&self) -> f64 {

@@ -116,12 +116,7 @@ impl BankSummary {
             description: bank.description.clone(),
             author: bank.author.clone(),
             license: bank.license.clone(),
-            source_kind: bank
-                .source
-                .as_ref()
-                .and_then(|s| s.get("kind"))
-                .and_then(|k| k.as_str())
-                .map(str::to_string),
+            source_kind: bank.source_text("kind").map(str::to_string),
             root_hz: bank.effective_root_hz(),
             num_modes: bank.modes.len(),
             freq_range_hz: if bank.modes.is_empty() {

@@ -18,27 +18,30 @@ const LIBRARY_MATERIALS: [&str; 8] = [
     "acrylic",
 ];
 
-fn source_str<'a>(bank: &'a Bank, key: &str) -> &'a str {
-    bank.source
-        .as_ref()
-        .and_then(|s| s.get(key))
-        .and_then(|v| v.as_str())
-        .unwrap_or("")
-}
-
 #[test]
 fn analytic_banks_cover_every_object_and_material() {
     let banks = designed_factory_banks();
     for bank in &banks {
         assert_eq!(bank.license, "CC0-1.0", "{}", bank.name);
         assert_eq!(bank.author, "Modal Resonator", "{}", bank.name);
-        assert_eq!(source_str(bank, "kind"), "analytic", "{}", bank.name);
+        assert_eq!(
+            bank.source_text("kind").unwrap_or(""),
+            "analytic",
+            "{}",
+            bank.name
+        );
     }
-    let shapes: HashSet<&str> = banks.iter().map(|b| source_str(b, "shape")).collect();
+    let shapes: HashSet<&str> = banks
+        .iter()
+        .map(|b| b.source_text("shape").unwrap_or(""))
+        .collect();
     for object in OBJECTS {
         assert!(shapes.contains(object.name), "no factory {}", object.name);
     }
-    let used: HashSet<&str> = banks.iter().map(|b| source_str(b, "material")).collect();
+    let used: HashSet<&str> = banks
+        .iter()
+        .map(|b| b.source_text("material").unwrap_or(""))
+        .collect();
     for name in LIBRARY_MATERIALS {
         assert!(used.contains(name), "no factory bank of {name}");
         assert!(materials::Material::by_name(name).is_some());

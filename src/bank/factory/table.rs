@@ -6,14 +6,7 @@ use crate::bank::Bank;
 
 /// What a factory bank was made from, for the table: "free-free-bar, steel", or the recording.
 fn made_from(bank: &Bank) -> String {
-    let field = |key: &str| {
-        bank.source
-            .as_ref()
-            .and_then(|s| s.get(key))
-            .and_then(|v| v.as_str())
-            .unwrap_or("")
-            .to_string()
-    };
+    let field = |key: &str| bank.source_text(key).unwrap_or("").to_string();
     if field("kind") == "fitted" {
         let file = field("file");
         let file = file.rsplit('/').next().unwrap_or("");

@@ -5,14 +5,6 @@ use crate::bank::summary::note_name;
 use crate::bank::validate::validate_bank;
 use std::collections::HashSet;
 
-fn source_str<'a>(bank: &'a Bank, key: &str) -> &'a str {
-    bank.source
-        .as_ref()
-        .and_then(|s| s.get(key))
-        .and_then(|v| v.as_str())
-        .unwrap_or("")
-}
-
 #[test]
 fn the_library_is_complete_and_distinct() {
     let banks = factory_banks();
@@ -57,8 +49,17 @@ fn the_library_is_complete_and_distinct() {
     let fitted = fitted_factory_banks();
     assert_eq!(fitted.len(), FITTED_PRESETS.len());
     for bank in &fitted {
-        assert_eq!(source_str(bank, "kind"), "fitted", "{}", bank.name);
-        assert!(!source_str(bank, "recording").is_empty(), "{}", bank.name);
+        assert_eq!(
+            bank.source_text("kind").unwrap_or(""),
+            "fitted",
+            "{}",
+            bank.name
+        );
+        assert!(
+            !bank.source_text("recording").unwrap_or("").is_empty(),
+            "{}",
+            bank.name
+        );
     }
 }
 
