@@ -2,7 +2,7 @@
 
 use super::*;
 use crate::authoring::materials;
-use crate::authoring::shapes::OBJECTS;
+use crate::authoring::shapes::ObjectKind;
 use crate::bank::factory::{factory_bank, factory_slug, preset_json};
 use std::collections::HashSet;
 
@@ -16,6 +16,22 @@ const LIBRARY_MATERIALS: [&str; 8] = [
     "rosewood",
     "spruce",
     "acrylic",
+];
+
+/// The objects the analytic factory has banks of, by name: a new object may come before its
+/// bank.
+const LIBRARY_OBJECTS: [&str; 11] = [
+    "ideal-string",
+    "stiff-string",
+    "free-free-bar",
+    "clamped-free-bar",
+    "tuned-bar",
+    "circular-membrane",
+    "rectangular-membrane",
+    "rectangular-plate",
+    "circular-plate",
+    "bell",
+    "bowl",
 ];
 
 fn source_str<'a>(bank: &'a Bank, key: &str) -> &'a str {
@@ -35,8 +51,9 @@ fn analytic_banks_cover_every_object_and_material() {
         assert_eq!(source_str(bank, "kind"), "analytic", "{}", bank.name);
     }
     let shapes: HashSet<&str> = banks.iter().map(|b| source_str(b, "shape")).collect();
-    for object in OBJECTS {
-        assert!(shapes.contains(object.name), "no factory {}", object.name);
+    for name in LIBRARY_OBJECTS {
+        assert!(shapes.contains(name), "no factory {name}");
+        assert!(ObjectKind::by_name(name).is_some(), "no object {name}");
     }
     let used: HashSet<&str> = banks.iter().map(|b| source_str(b, "material")).collect();
     for name in LIBRARY_MATERIALS {
