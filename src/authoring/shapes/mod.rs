@@ -34,6 +34,7 @@ mod positions;
 pub mod rect_membrane;
 mod shape;
 pub mod string;
+pub mod triangle;
 
 pub use bar::{Bar, TunedBar, BAR_TUNINGS, MARIMBA_RATIOS, VIBRAPHONE_RATIOS, XYLOPHONE_RATIOS};
 pub use bell::{BellPartial, TunedBell, TUNED_BELL_PARTIALS};
@@ -63,6 +64,7 @@ shape::register_shapes! {
     CircularPlate(CircularPlate) => circular_plate::CIRCULAR_PLATE,
     Bell(TunedBell) => bell::BELL,
     Bowl(Bowl) => bowl::BOWL,
+    Triangle(triangle::Triangle) => triangle::TRIANGLE,
 }
 
 use crate::authoring::materials::{Material, AIR_DAMPING_PER_S};
