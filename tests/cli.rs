@@ -2366,3 +2366,39 @@ fn mesh_default_strike_points_sound_a_bar_s_fundamental() {
         .fold(0.0, f64::max);
     assert_eq!(first.gains[0].abs(), peak_at_default, "{:?}", bank.modes);
 }
+
+#[test]
+fn shape_builds_a_triangle_at_the_requested_root() {
+    let dir = dir_with_bank();
+    let out = run(
+        dir.path(),
+        &[
+            "shape",
+            "triangle",
+            "--root-note",
+            "A5",
+            "-o",
+            "triangle.json",
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("root 880.00 Hz (A5)"),
+        "{}",
+        stdout(&out)
+    );
+    let bank = modal_resonator::bank::load_bank_file(&dir.path().join("triangle.json")).unwrap();
+    assert!(modal_resonator::bank::validate::validate_bank(&bank).is_empty());
+    assert!((bank.root_hz.unwrap() / 880.0 - 1.0).abs() < 1e-12);
+    assert_eq!(bank.modes[0].freq_hz, bank.root_hz.unwrap());
+    // The free-free rod's partials, 1 : 2.756 : 5.404.
+    for (k, ratio) in [(1, 2.756), (2, 5.404)] {
+        let got = bank.modes[k].freq_hz / bank.modes[0].freq_hz;
+        assert!((got / ratio - 1.0).abs() < 1e-3, "mode {k}: {got}");
+    }
+    let source = bank.source.unwrap();
+    assert_eq!(source["shape"], "triangle");
+    assert_eq!(source["material"], "steel");
+    let help = stdout(&run(dir.path(), &["shape", "--help"]));
+    assert!(help.contains("triangle"), "{help}");
+}

@@ -3,7 +3,8 @@
 use super::{key, FactoryObject, Tweaks};
 use crate::authoring::materials;
 use crate::authoring::shapes::{
-    Bar, Shape, StretchedString, TunedBar, MARIMBA_RATIOS, VIBRAPHONE_RATIOS, XYLOPHONE_RATIOS,
+    Bar, Cantilever, IdealString, Shape, StiffString, StretchedString, TunedBar, MARIMBA_RATIOS,
+    VIBRAPHONE_RATIOS, XYLOPHONE_RATIOS,
 };
 
 /// Contact time in ms of one clave struck against the other: hardwood on hardwood, as short as
@@ -22,11 +23,11 @@ pub(super) fn objects() -> Vec<FactoryObject> {
             description: "A string with no stiffness, struck by a point hammer: a pure harmonic \
                           series whose spectrum falls as 1/n, with the harmonics at the strike \
                           point's nodes missing. The textbook reference for every other bank.",
-            shape: Shape::IdealString(StretchedString {
+            shape: Shape::IdealString(IdealString(StretchedString {
                 length_m: 0.65,
                 diameter_m: 0.9e-3,
                 tension_n: 100.0,
-            }),
+            })),
             material: &materials::STEEL,
             root_key: key::A2,
             tweaks: Tweaks::NONE,
@@ -36,11 +37,11 @@ pub(super) fn objects() -> Vec<FactoryObject> {
             description: "A plain steel piano wire at middle C, struck near one end like a \
                           piano hammer: the wire's stiffness stretches the upper partials sharp \
                           (inharmonicity B about 4e-4), the shimmer of a real piano tone.",
-            shape: Shape::StiffString(StretchedString {
+            shape: Shape::StiffString(StiffString(StretchedString {
                 length_m: 0.62,
                 diameter_m: 1.0e-3,
                 tension_n: 650.0,
-            }),
+            })),
             material: &materials::STEEL,
             root_key: key::C4,
             tweaks: Tweaks::NONE,
@@ -164,11 +165,11 @@ pub(super) fn objects() -> Vec<FactoryObject> {
                           a kalimba or mbira key: a round fundamental with the bright clang \
                           partial 6.27 times higher (the clamped-free bar's 1 : 6.27 : 17.5). \
                           The resonating box is not modelled.",
-            shape: Shape::ClampedFreeBar(Bar {
+            shape: Shape::ClampedFreeBar(Cantilever(Bar {
                 length_m: 0.06,
                 width_m: 0.004,
                 thickness_m: 0.0012,
-            }),
+            })),
             material: &materials::STEEL,
             root_key: key::C5,
             tweaks: Tweaks::NONE,
@@ -179,11 +180,11 @@ pub(super) fn objects() -> Vec<FactoryObject> {
                           struck on a rubber block: an almost pure tone that rings for tens of \
                           seconds, with a faint clang partial 6.27 times higher that dies \
                           first.",
-            shape: Shape::ClampedFreeBar(Bar {
+            shape: Shape::ClampedFreeBar(Cantilever(Bar {
                 length_m: 0.086,
                 width_m: 0.005,
                 thickness_m: 0.004,
-            }),
+            })),
             material: &materials::STEEL,
             root_key: key::A4,
             tweaks: Tweaks {

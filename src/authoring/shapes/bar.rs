@@ -10,8 +10,13 @@
 //! which have unit mean square over the bar. Torsional and width-wise modes, shear and rotary
 //! inertia (Timoshenko corrections, a few percent for the upper modes of thick bars) are left out.
 
-use super::{ModeLimits, ShapeError, ShapedMode};
-use crate::authoring::materials::Material;
+use super::objects::{Dimension, ObjectKind, ObjectOption, ObjectSpec};
+use super::positions::{line_coords, position};
+use super::shape::{mm, Object};
+use super::{ModeLimits, Shape, ShapeError, ShapedMode};
+use crate::authoring::materials::{self, Material};
+use crate::bank::Position;
+use serde_json::{json, Map, Value};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
 
 /// Marimba tuning: the second mode two octaves above the first, the third three octaves and a
@@ -25,7 +30,54 @@ pub const VIBRAPHONE_RATIOS: [f64; 2] = [1.0, 4.0];
 /// (Fletcher & Rossing ch. 19).
 pub const XYLOPHONE_RATIOS: [f64; 2] = [1.0, 3.0];
 
-/// A bar of rectangular section, free at both ends.
+/// Named tunings of a tuned bar.
+pub const BAR_TUNINGS: [(&str, &[f64]); 3] = [
+    ("marimba", &MARIMBA_RATIOS),
+    ("vibraphone", &VIBRAPHONE_RATIOS),
+    ("xylophone", &XYLOPHONE_RATIOS),
+];
+
+/// Where a bar is usually struck: near its centre, off the antisymmetric modes' node.
+const BAR_STRIKE: f64 = 0.4;
+
+/// `free-free-bar` on the command line.
+pub static FREE_FREE_BAR: ObjectKind = ObjectKind {
+    name: "free-free-bar",
+    about: "uniform bar free at both ends (glockenspiel): 1 : 2.756 : 5.404",
+    dimensions: &[
+        (Dimension::Length, "m", 0.3),
+        (Dimension::Width, "m", 0.03),
+        (Dimension::Thickness, "m", 0.01),
+    ],
+    options: &[],
+    default_material: &materials::STEEL,
+    build: |spec| Shape::FreeFreeBar(Bar::from_spec(spec)),
+};
+
+/// `tuned-bar` on the command line.
+pub static TUNED_BAR: ObjectKind = ObjectKind {
+    name: "tuned-bar",
+    about: "undercut bar with tuned overtones (--tuning marimba, vibraphone, xylophone)",
+    dimensions: &[
+        (Dimension::Length, "m", 0.38),
+        (Dimension::Width, "m", 0.06),
+        (Dimension::Thickness, "m", 0.009),
+    ],
+    options: &[ObjectOption::Tuning],
+    default_material: &materials::ROSEWOOD,
+    build: |spec| {
+        Shape::TunedBar(TunedBar {
+            bar: Bar::from_spec(spec),
+            tuned_ratios: spec
+                .tuning
+                .clone()
+                .unwrap_or_else(|| MARIMBA_RATIOS.to_vec()),
+        })
+    },
+};
+
+/// A bar of rectangular section, free at both ends. Positions: one coordinate, fraction of the
+/// length.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Bar {
     /// Length in m.
@@ -36,7 +88,8 @@ pub struct Bar {
     pub thickness_m: f64,
 }
 
-/// An undercut bar whose first modes are tuned to set ratios.
+/// An undercut bar whose first modes are tuned to set ratios (marimba, vibraphone). Positions:
+/// fraction of the length.
 ///
 /// Only the frequencies are tuned: modes past the tuned ones continue the free-free progression
 /// from the last tuned mode, `f_k = f_last (b_k / b_last)^2`, and every mode keeps the shape of the
@@ -116,26 +169,32 @@ impl Bar {
         }
     }
 
-    pub(super) fn validate(&self) -> Result<(), ShapeError> {
-        super::check_positive("length_m", self.length_m)?;
-        super::check_positive("width_m", self.width_m)?;
-        super::check_positive("thickness_m", self.thickness_m)
+    /// The bar of `spec`'s dimensions.
+    pub(super) fn from_spec(spec: &ObjectSpec) -> Self {
+        Self {
+            length_m: spec.value(Dimension::Length),
+            width_m: spec.value(Dimension::Width),
+            thickness_m: spec.value(Dimension::Thickness),
+        }
     }
 
-    /// `Ok` when the bar is slender enough for the theory: checked once it is tuned.
-    pub(super) fn check_proportions(&self) -> Result<(), ShapeError> {
-        super::check_thin("thickness_m", self.thickness_m, self.length_m, "length")?;
-        if self.width_m > self.length_m {
-            return Err(ShapeError::BadParameter {
-                name: "width_m",
-                value: self.width_m,
-                reason: format!(
-                    "wider than the bar is long ({:.4} m): that is a plate",
-                    self.length_m
-                ),
-            });
-        }
-        Ok(())
+    /// Length, width and thickness, as a bank's source records them.
+    pub(super) fn dimensions(&self) -> Vec<(&'static str, f64)> {
+        vec![
+            ("length", self.length_m),
+            ("width", self.width_m),
+            ("thickness", self.thickness_m),
+        ]
+    }
+
+    /// "199.4 x 25.0 x 8.0 mm".
+    pub(super) fn outline(&self) -> String {
+        format!(
+            "{} x {} x {} mm",
+            mm(self.length_m),
+            mm(self.width_m),
+            mm(self.thickness_m)
+        )
     }
 
     /// Free-free modes up to the limits, shapes at `coords` (fractions of the length).
@@ -172,8 +231,8 @@ impl TunedBar {
         }
     }
 
-    pub(super) fn validate(&self) -> Result<(), ShapeError> {
-        self.bar.validate()?;
+    /// `Ok` when the ratios start with 1.0 and ascend.
+    fn check_ratios(&self) -> Result<(), ShapeError> {
         let ratios = &self.tuned_ratios;
         let ascending = ratios.windows(2).all(|pair| pair[1] > pair[0]);
         if ratios.first() != Some(&1.0) || !ascending || ratios.iter().any(|r| !r.is_finite()) {
@@ -204,6 +263,135 @@ impl TunedBar {
             modes.push(ShapedMode { freq_hz, shape });
         }
         modes
+    }
+}
+
+/// Positions along a bar free at both ends, from an end to the centre.
+fn free_bar_positions() -> Vec<Position> {
+    vec![
+        position("end", &[0.0]),
+        position("quarter", &[0.25]),
+        position("near centre", &[0.4]),
+        position("centre", &[0.5]),
+    ]
+}
+
+impl Object for Bar {
+    fn display_kind(&self) -> &'static str {
+        "free-free bar"
+    }
+
+    fn validate(&self) -> Result<(), ShapeError> {
+        super::check_positive("length_m", self.length_m)?;
+        super::check_positive("width_m", self.width_m)?;
+        super::check_positive("thickness_m", self.thickness_m)
+    }
+
+    /// `Ok` when the bar is slender enough for the theory: checked once it is tuned.
+    fn check_proportions(&self) -> Result<(), ShapeError> {
+        super::check_thin("thickness_m", self.thickness_m, self.length_m, "length")?;
+        if self.width_m > self.length_m {
+            return Err(ShapeError::BadParameter {
+                name: "width_m",
+                value: self.width_m,
+                reason: format!(
+                    "wider than the bar is long ({:.4} m): that is a plate",
+                    self.length_m
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    fn root_hz(&self, material: &Material) -> f64 {
+        self.fundamental_hz(material)
+    }
+
+    fn tuned(&self, material: &Material, root_hz: f64) -> Result<Shape, ShapeError> {
+        Ok(self.tuned_to(material, root_hz).into())
+    }
+
+    fn modes_at(
+        &self,
+        material: &Material,
+        positions: &[Position],
+        limits: &ModeLimits,
+    ) -> Result<Vec<ShapedMode>, ShapeError> {
+        Ok(self.shaped_modes(material, &line_coords(positions)?, limits))
+    }
+
+    fn default_positions(&self) -> Vec<Position> {
+        free_bar_positions()
+    }
+
+    fn typical_strike(&self) -> Vec<f64> {
+        vec![BAR_STRIKE]
+    }
+
+    fn dimensions_m(&self) -> Vec<(&'static str, f64)> {
+        self.dimensions()
+    }
+
+    fn size(&self) -> String {
+        self.outline()
+    }
+}
+
+impl Object for TunedBar {
+    fn display_kind(&self) -> &'static str {
+        "tuned bar"
+    }
+
+    fn validate(&self) -> Result<(), ShapeError> {
+        self.bar.validate()?;
+        self.check_ratios()
+    }
+
+    fn check_proportions(&self) -> Result<(), ShapeError> {
+        self.bar.check_proportions()
+    }
+
+    fn root_hz(&self, material: &Material) -> f64 {
+        self.bar.fundamental_hz(material)
+    }
+
+    fn tuned(&self, material: &Material, root_hz: f64) -> Result<Shape, ShapeError> {
+        Ok(TunedBar {
+            bar: self.bar.tuned_to(material, root_hz),
+            tuned_ratios: self.tuned_ratios.clone(),
+        }
+        .into())
+    }
+
+    fn modes_at(
+        &self,
+        material: &Material,
+        positions: &[Position],
+        limits: &ModeLimits,
+    ) -> Result<Vec<ShapedMode>, ShapeError> {
+        Ok(self.shaped_modes(material, &line_coords(positions)?, limits))
+    }
+
+    fn default_positions(&self) -> Vec<Position> {
+        free_bar_positions()
+    }
+
+    fn typical_strike(&self) -> Vec<f64> {
+        vec![BAR_STRIKE]
+    }
+
+    fn dimensions_m(&self) -> Vec<(&'static str, f64)> {
+        self.bar.dimensions()
+    }
+
+    fn parameters(&self, _material: &Material) -> Map<String, Value> {
+        let mut map = Map::new();
+        map.insert("tuned_ratios".into(), json!(self.tuned_ratios));
+        map
+    }
+
+    fn size(&self) -> String {
+        self.bar.outline()
     }
 }
 

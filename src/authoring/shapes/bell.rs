@@ -23,8 +23,13 @@
 //! bell struck normally barely sounds its quint (Hibbert). The placements are estimates from
 //! the published nodal patterns, not measurements.
 
-use super::{ModeLimits, ShapeError, ShapedMode};
-use crate::authoring::materials::Material;
+use super::objects::{Dimension, ObjectKind};
+use super::positions::{line_coords, position};
+use super::shape::{mm, Object};
+use super::{check_thin, ModeLimits, Shape, ShapeError, ShapedMode};
+use crate::authoring::materials::{self, Material};
+use crate::bank::Position;
+use serde_json::{json, Map, Value};
 
 /// One partial of the tuned bell.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -60,7 +65,26 @@ pub const TUNED_BELL_PARTIALS: [BellPartial; 11] = [
 /// Where the clapper strikes: the middle of the sound bow, on the quint's nodal circle.
 pub const SOUND_BOW: f64 = 0.9;
 
-/// A church bell of the classic Western profile.
+/// `bell` on the command line.
+pub static BELL: ObjectKind = ObjectKind {
+    name: "bell",
+    about: "tuned church bell: hum, prime, tierce, quint, nominal",
+    dimensions: &[
+        (Dimension::Diameter, "m", 0.6),
+        (Dimension::Thickness, "m", 0.046),
+    ],
+    options: &[],
+    default_material: &materials::BRONZE,
+    build: |spec| {
+        Shape::Bell(TunedBell {
+            diameter_m: spec.value(Dimension::Diameter),
+            thickness_m: spec.value(Dimension::Thickness),
+        })
+    },
+};
+
+/// A church bell of the classic Western profile. Positions: along the profile, 0 at the crown,
+/// 1 at the lip.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TunedBell {
     /// Diameter of the mouth in m.
@@ -89,11 +113,6 @@ impl TunedBell {
         }
     }
 
-    pub(super) fn validate(&self) -> Result<(), ShapeError> {
-        super::check_positive("diameter_m", self.diameter_m)?;
-        super::check_positive("thickness_m", self.thickness_m)
-    }
-
     /// The partials within the limits, heuristic shapes at `coords` (along the profile).
     pub(super) fn shaped_modes(
         &self,
@@ -111,6 +130,78 @@ impl TunedBell {
             })
             .filter(|mode| mode.freq_hz < limits.max_freq_hz)
             .collect()
+    }
+}
+
+impl Object for TunedBell {
+    fn display_kind(&self) -> &'static str {
+        "tuned bell"
+    }
+
+    fn validate(&self) -> Result<(), ShapeError> {
+        super::check_positive("diameter_m", self.diameter_m)?;
+        super::check_positive("thickness_m", self.thickness_m)
+    }
+
+    fn check_proportions(&self) -> Result<(), ShapeError> {
+        check_thin("thickness_m", self.thickness_m, self.diameter_m, "diameter")
+    }
+
+    /// The strike note, the prime (an octave above the hum).
+    fn root_hz(&self, material: &Material) -> f64 {
+        self.prime_hz(material)
+    }
+
+    fn root_name(&self) -> &'static str {
+        "prime"
+    }
+
+    fn tuned(&self, material: &Material, root_hz: f64) -> Result<Shape, ShapeError> {
+        Ok(self.tuned_to(material, root_hz).into())
+    }
+
+    fn modes_at(
+        &self,
+        material: &Material,
+        positions: &[Position],
+        limits: &ModeLimits,
+    ) -> Result<Vec<ShapedMode>, ShapeError> {
+        Ok(self.shaped_modes(material, &line_coords(positions)?, limits))
+    }
+
+    fn default_positions(&self) -> Vec<Position> {
+        vec![
+            position("shoulder", &[0.2]),
+            position("waist", &[0.55]),
+            position("sound bow", &[SOUND_BOW]),
+            position("lip", &[1.0]),
+        ]
+    }
+
+    fn typical_strike(&self) -> Vec<f64> {
+        vec![SOUND_BOW]
+    }
+
+    fn dimensions_m(&self) -> Vec<(&'static str, f64)> {
+        vec![
+            ("diameter", self.diameter_m),
+            ("thickness", self.thickness_m),
+        ]
+    }
+
+    fn parameters(&self, _material: &Material) -> Map<String, Value> {
+        let ratios: Vec<f64> = TUNED_BELL_PARTIALS.iter().map(|p| p.ratio).collect();
+        let mut map = Map::new();
+        map.insert("partial_ratios".into(), json!(ratios));
+        map
+    }
+
+    fn size(&self) -> String {
+        format!(
+            "{} mm across, sound bow {} mm thick",
+            mm(self.diameter_m),
+            mm(self.thickness_m)
+        )
     }
 }
 

@@ -20,8 +20,13 @@
 //! (pi / 2) (Rayleigh section 234): the higher the mode, the more it keeps to the rim. Positions
 //! run along the wall, 0 at the base, 1 at the rim.
 
-use super::{ModeLimits, ShapeError, ShapedMode};
-use crate::authoring::materials::Material;
+use super::objects::{Dimension, ObjectKind};
+use super::positions::{line_coords, position};
+use super::shape::{mm, Object};
+use super::{check_thin, ModeLimits, Shape, ShapeError, ShapedMode};
+use crate::authoring::materials::{self, Material};
+use crate::bank::Position;
+use serde_json::{json, Map, Value};
 use std::f64::consts::{FRAC_PI_2, TAU};
 
 /// Relative frequency gap between the two modes of a pair (0.2 %: about 1 Hz at 500 Hz, the
@@ -37,7 +42,26 @@ pub const RIM: f64 = 1.0;
 /// Highest number of waves around the rim.
 const MAX_WAVES: u32 = 40;
 
-/// An open round shell.
+/// `bowl` on the command line.
+pub static BOWL: ObjectKind = ObjectKind {
+    name: "bowl",
+    about: "open bowl or glass rung at its rim: singing bowl, wine glass, cup",
+    dimensions: &[
+        (Dimension::Diameter, "m", 0.2),
+        (Dimension::Thickness, "m", 0.004),
+    ],
+    options: &[],
+    default_material: &materials::BRONZE,
+    build: |spec| {
+        Shape::Bowl(Bowl {
+            diameter_m: spec.value(Dimension::Diameter),
+            thickness_m: spec.value(Dimension::Thickness),
+        })
+    },
+};
+
+/// An open round shell: a bowl or a glass. Positions: along the wall, 0 at the base, 1 at the
+/// rim.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Bowl {
     /// Diameter of the rim in m.
@@ -64,11 +88,6 @@ impl Bowl {
             diameter_m: self.diameter_m * scale,
             thickness_m: self.thickness_m * scale,
         }
-    }
-
-    pub(super) fn validate(&self) -> Result<(), ShapeError> {
-        super::check_positive("diameter_m", self.diameter_m)?;
-        super::check_positive("thickness_m", self.thickness_m)
     }
 
     /// The pairs of (m, 0) modes within the limits, shapes at `coords` (along the wall).
@@ -99,6 +118,73 @@ impl Bowl {
             }
         }
         modes
+    }
+}
+
+impl Object for Bowl {
+    fn display_kind(&self) -> &'static str {
+        "bowl"
+    }
+
+    fn validate(&self) -> Result<(), ShapeError> {
+        super::check_positive("diameter_m", self.diameter_m)?;
+        super::check_positive("thickness_m", self.thickness_m)
+    }
+
+    fn check_proportions(&self) -> Result<(), ShapeError> {
+        check_thin("thickness_m", self.thickness_m, self.diameter_m, "diameter")
+    }
+
+    fn root_hz(&self, material: &Material) -> f64 {
+        self.fundamental_hz(material)
+    }
+
+    fn tuned(&self, material: &Material, root_hz: f64) -> Result<Shape, ShapeError> {
+        Ok(self.tuned_to(material, root_hz).into())
+    }
+
+    fn modes_at(
+        &self,
+        material: &Material,
+        positions: &[Position],
+        limits: &ModeLimits,
+    ) -> Result<Vec<ShapedMode>, ShapeError> {
+        Ok(self.shaped_modes(material, &line_coords(positions)?, limits))
+    }
+
+    fn default_positions(&self) -> Vec<Position> {
+        vec![
+            position("low on the wall", &[0.4]),
+            position("middle of the wall", &[0.65]),
+            position("below the rim", &[0.85]),
+            position("rim", &[RIM]),
+        ]
+    }
+
+    fn typical_strike(&self) -> Vec<f64> {
+        vec![RIM]
+    }
+
+    fn dimensions_m(&self) -> Vec<(&'static str, f64)> {
+        vec![
+            ("diameter", self.diameter_m),
+            ("thickness", self.thickness_m),
+        ]
+    }
+
+    fn parameters(&self, _material: &Material) -> Map<String, Value> {
+        let mut map = Map::new();
+        map.insert("doublet_split".into(), json!(DOUBLET_SPLIT));
+        map.insert("strike_angle_rad".into(), json!(STRIKE_ANGLE_RAD));
+        map
+    }
+
+    fn size(&self) -> String {
+        format!(
+            "{} mm across the rim, wall {} mm thick",
+            mm(self.diameter_m),
+            mm(self.thickness_m)
+        )
     }
 }
 

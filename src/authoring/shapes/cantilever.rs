@@ -12,9 +12,35 @@
 //!
 //! Positions are fractions of the length from the clamp (0) to the free tip (1).
 
-use super::{Bar, ModeLimits, ShapeError, ShapedMode};
-use crate::authoring::materials::Material;
+use super::objects::{Dimension, ObjectKind};
+use super::positions::{line_coords, position};
+use super::shape::Object;
+use super::{Bar, ModeLimits, Shape, ShapeError, ShapedMode};
+use crate::authoring::materials::{self, Material};
+use crate::bank::Position;
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+
+/// Where a tine is struck: its free tip.
+const TIP: f64 = 1.0;
+
+/// `clamped-free-bar` on the command line.
+pub static CLAMPED_FREE_BAR: ObjectKind = ObjectKind {
+    name: "clamped-free-bar",
+    about: "bar clamped at one end (kalimba tine, tuning fork prong): 1 : 6.267 : 17.55",
+    dimensions: &[
+        (Dimension::Length, "m", 0.06),
+        (Dimension::Width, "m", 0.004),
+        (Dimension::Thickness, "m", 0.0012),
+    ],
+    options: &[],
+    default_material: &materials::STEEL,
+    build: |spec| Shape::ClampedFreeBar(Cantilever(Bar::from_spec(spec))),
+};
+
+/// A uniform bar clamped at one end (kalimba tine): its free length, width and thickness.
+/// Positions: fraction of the length from the clamp.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cantilever(pub Bar);
 
 /// `b_n L` of clamped-free mode `n` (from 1): the n-th positive root of `cos(x) cosh(x) = -1`.
 pub fn clamped_free_beta_l(n: usize) -> f64 {
@@ -57,48 +83,97 @@ pub fn clamped_free_shape(beta_l: f64, x: f64) -> f64 {
     growing + decaying - u.cos() + s * u.sin()
 }
 
-/// Fundamental in Hz of `bar` clamped at one end.
-pub fn fundamental_hz(bar: &Bar, material: &Material) -> f64 {
-    bar.flexural_freq_hz(material, clamped_free_beta_l(1))
-}
-
-/// `bar` with its free length changed so that, clamped, its fundamental is `root_hz`
-/// (`f ~ 1 / L^2`).
-pub fn tuned_to(bar: &Bar, material: &Material, root_hz: f64) -> Bar {
-    let scale = (fundamental_hz(bar, material) / root_hz).sqrt();
-    Bar {
-        length_m: bar.length_m * scale,
-        ..bar.clone()
+impl Cantilever {
+    /// Fundamental in Hz.
+    pub fn fundamental_hz(&self, material: &Material) -> f64 {
+        self.0.flexural_freq_hz(material, clamped_free_beta_l(1))
     }
-}
 
-/// Clamped-free modes of `bar` up to the limits, shapes at `coords` (fractions of the length
-/// from the clamp).
-pub(super) fn shaped_modes(
-    bar: &Bar,
-    material: &Material,
-    coords: &[f64],
-    limits: &ModeLimits,
-) -> Vec<ShapedMode> {
-    let mut modes = Vec::new();
-    for n in 1..=limits.max_modes {
-        let beta_l = clamped_free_beta_l(n);
-        let freq_hz = bar.flexural_freq_hz(material, beta_l);
-        if freq_hz >= limits.max_freq_hz {
-            break;
+    /// The tine with its free length changed so that its fundamental is `root_hz`
+    /// (`f ~ 1 / L^2`).
+    pub fn tuned_to(&self, material: &Material, root_hz: f64) -> Self {
+        let scale = (self.fundamental_hz(material) / root_hz).sqrt();
+        Self(Bar {
+            length_m: self.0.length_m * scale,
+            ..self.0.clone()
+        })
+    }
+
+    /// Clamped-free modes up to the limits, shapes at `coords` (fractions of the length from
+    /// the clamp).
+    pub(super) fn shaped_modes(
+        &self,
+        material: &Material,
+        coords: &[f64],
+        limits: &ModeLimits,
+    ) -> Vec<ShapedMode> {
+        let mut modes = Vec::new();
+        for n in 1..=limits.max_modes {
+            let beta_l = clamped_free_beta_l(n);
+            let freq_hz = self.0.flexural_freq_hz(material, beta_l);
+            if freq_hz >= limits.max_freq_hz {
+                break;
+            }
+            let shape = coords
+                .iter()
+                .map(|&x| clamped_free_shape(beta_l, x))
+                .collect();
+            modes.push(ShapedMode { freq_hz, shape });
         }
-        let shape = coords
-            .iter()
-            .map(|&x| clamped_free_shape(beta_l, x))
-            .collect();
-        modes.push(ShapedMode { freq_hz, shape });
+        modes
     }
-    modes
 }
 
-/// `Ok` when the bar's dimensions are in range.
-pub(super) fn validate(bar: &Bar) -> Result<(), ShapeError> {
-    bar.validate()
+impl Object for Cantilever {
+    fn display_kind(&self) -> &'static str {
+        "clamped-free bar"
+    }
+
+    fn validate(&self) -> Result<(), ShapeError> {
+        self.0.validate()
+    }
+
+    fn check_proportions(&self) -> Result<(), ShapeError> {
+        self.0.check_proportions()
+    }
+
+    fn root_hz(&self, material: &Material) -> f64 {
+        self.fundamental_hz(material)
+    }
+
+    fn tuned(&self, material: &Material, root_hz: f64) -> Result<Shape, ShapeError> {
+        Ok(self.tuned_to(material, root_hz).into())
+    }
+
+    fn modes_at(
+        &self,
+        material: &Material,
+        positions: &[Position],
+        limits: &ModeLimits,
+    ) -> Result<Vec<ShapedMode>, ShapeError> {
+        Ok(self.shaped_modes(material, &line_coords(positions)?, limits))
+    }
+
+    fn default_positions(&self) -> Vec<Position> {
+        vec![
+            position("middle", &[0.5]),
+            position("three quarters", &[0.75]),
+            position("near the tip", &[0.9]),
+            position("tip", &[TIP]),
+        ]
+    }
+
+    fn typical_strike(&self) -> Vec<f64> {
+        vec![TIP]
+    }
+
+    fn dimensions_m(&self) -> Vec<(&'static str, f64)> {
+        self.0.dimensions()
+    }
+
+    fn size(&self) -> String {
+        self.0.outline()
+    }
 }
 
 #[cfg(test)]

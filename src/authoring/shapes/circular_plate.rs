@@ -24,9 +24,34 @@
 
 use super::bessel::{bessel_i_scaled_upto, bessel_j_upto, roots_by_scan};
 use super::disc::{unit_mean_square_scale, DiscPoints};
-use super::{ModeLimits, ShapeError, ShapedMode};
-use crate::authoring::materials::Material;
+use super::membrane::DISC_STRIKE;
+use super::objects::{Dimension, ObjectKind, ObjectOption};
+use super::positions::{plane_coords, position};
+use super::shape::{mm, Object};
+use super::{check_thin, ModeLimits, Shape, ShapeError, ShapedMode};
+use crate::authoring::materials::{self, Material};
+use crate::bank::Position;
+use serde_json::{json, Map, Value};
 use std::f64::consts::TAU;
+
+/// `circular-plate` on the command line.
+pub static CIRCULAR_PLATE: ObjectKind = ObjectKind {
+    name: "circular-plate",
+    about: "thin disc, free or clamped at its rim (--edge): gong, cymbal, saucer",
+    dimensions: &[
+        (Dimension::Radius, "m", 0.15),
+        (Dimension::Thickness, "m", 0.002),
+    ],
+    options: &[ObjectOption::Edge],
+    default_material: &materials::BRASS,
+    build: |spec| {
+        Shape::CircularPlate(CircularPlate {
+            radius_m: spec.value(Dimension::Radius),
+            thickness_m: spec.value(Dimension::Thickness),
+            edge: spec.edge.unwrap_or(PlateEdge::Free),
+        })
+    },
+};
 
 /// How the rim of a circular plate is held.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -75,7 +100,8 @@ const FIRST_LAMBDA_BOUND: f64 = 12.0;
 /// wiggle with period `2 pi / lambda`, at least 0.15 of the radius for 300 modes.
 const NORM_STEPS: usize = 400;
 
-/// A flat plate of uniform thickness with a circular outline.
+/// A flat plate of uniform thickness with a circular outline, free or clamped at its rim.
+/// Positions: `(x, y)` in fractions of the radius from the centre.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CircularPlate {
     /// Radius in m.
@@ -212,11 +238,6 @@ impl CircularPlate {
         }
     }
 
-    pub(super) fn validate(&self) -> Result<(), ShapeError> {
-        super::check_positive("radius_m", self.radius_m)?;
-        super::check_positive("thickness_m", self.thickness_m)
-    }
-
     /// The lowest modes within the limits, shapes (unit mean square over the plate) at `coords`.
     pub(super) fn shaped_modes(
         &self,
@@ -262,6 +283,77 @@ impl CircularPlate {
             });
         }
         modes
+    }
+}
+
+impl Object for CircularPlate {
+    fn display_kind(&self) -> &'static str {
+        match self.edge {
+            PlateEdge::Free => "free circular plate",
+            PlateEdge::Clamped => "clamped circular plate",
+        }
+    }
+
+    fn validate(&self) -> Result<(), ShapeError> {
+        super::check_positive("radius_m", self.radius_m)?;
+        super::check_positive("thickness_m", self.thickness_m)
+    }
+
+    fn check_proportions(&self) -> Result<(), ShapeError> {
+        check_thin(
+            "thickness_m",
+            self.thickness_m,
+            2.0 * self.radius_m,
+            "diameter",
+        )
+    }
+
+    fn root_hz(&self, material: &Material) -> f64 {
+        self.fundamental_hz(material)
+    }
+
+    fn tuned(&self, material: &Material, root_hz: f64) -> Result<Shape, ShapeError> {
+        Ok(self.tuned_to(material, root_hz).into())
+    }
+
+    fn modes_at(
+        &self,
+        material: &Material,
+        positions: &[Position],
+        limits: &ModeLimits,
+    ) -> Result<Vec<ShapedMode>, ShapeError> {
+        Ok(self.shaped_modes(material, &plane_coords(positions, true)?, limits))
+    }
+
+    fn default_positions(&self) -> Vec<Position> {
+        vec![
+            position("centre", &[0.0, 0.0]),
+            position("third radius", &[0.33, 0.0]),
+            position("two-thirds radius", &DISC_STRIKE),
+            position("near rim", &[0.9, 0.0]),
+        ]
+    }
+
+    fn typical_strike(&self) -> Vec<f64> {
+        DISC_STRIKE.to_vec()
+    }
+
+    fn dimensions_m(&self) -> Vec<(&'static str, f64)> {
+        vec![("radius", self.radius_m), ("thickness", self.thickness_m)]
+    }
+
+    fn parameters(&self, _material: &Material) -> Map<String, Value> {
+        let mut map = Map::new();
+        map.insert("edge".into(), json!(self.edge.name()));
+        map
+    }
+
+    fn size(&self) -> String {
+        format!(
+            "{} mm radius, {} mm thick",
+            mm(self.radius_m),
+            mm(self.thickness_m)
+        )
     }
 }
 

@@ -64,7 +64,7 @@ mod tests {
 
     #[test]
     fn every_object_builds_at_its_typical_size() {
-        for object in OBJECTS {
+        for &object in OBJECTS {
             let shape = ObjectSpec::typical(object).shape().unwrap();
             assert_eq!(shape.kind(), object.name);
             let design = BankDesign {

@@ -11,8 +11,13 @@
 
 use super::bessel::{bessel_j_upto, bessel_zeros_below};
 use super::disc::DiscPoints;
-use super::{ModeLimits, ShapeError, ShapedMode};
-use crate::authoring::materials::Material;
+use super::objects::{Dimension, ObjectKind};
+use super::positions::{plane_coords, position};
+use super::shape::{mm, Object, DRUM_STICK_MS};
+use super::{check_thin, ModeLimits, Shape, ShapeError, ShapedMode};
+use crate::authoring::materials::{self, Material};
+use crate::bank::Position;
+use serde_json::{json, Map, Value};
 use std::f64::consts::{SQRT_2, TAU};
 
 /// First zero of `J_0`, which sets the fundamental.
@@ -21,7 +26,31 @@ const J_0_1: f64 = 2.404_825_557_695_773;
 /// First argument bound of the search for Bessel zeros, grown by half until enough are found.
 const FIRST_ZERO_SEARCH_BOUND: f64 = 16.0;
 
-/// A circular membrane under uniform tension, fixed at its rim.
+/// Where a drum or a disc is usually struck: two thirds of the way out.
+pub(super) const DISC_STRIKE: [f64; 2] = [0.67, 0.0];
+
+/// `circular-membrane` on the command line.
+pub static CIRCULAR_MEMBRANE: ObjectKind = ObjectKind {
+    name: "circular-membrane",
+    about: "drum head fixed at its rim: Bessel-zero partials",
+    dimensions: &[
+        (Dimension::Radius, "m", 0.165),
+        (Dimension::Thickness, "m", 0.25e-3),
+        (Dimension::Tension, "N/m", 1400.0),
+    ],
+    options: &[],
+    default_material: &materials::MYLAR,
+    build: |spec| {
+        Shape::CircularMembrane(CircularMembrane {
+            radius_m: spec.value(Dimension::Radius),
+            thickness_m: spec.value(Dimension::Thickness),
+            tension_n_per_m: spec.value(Dimension::Tension),
+        })
+    },
+};
+
+/// A circular membrane under uniform tension, fixed at its rim: a drum head. Positions:
+/// `(x, y)` in fractions of the radius from the centre.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CircularMembrane {
     /// Radius in m.
@@ -61,12 +90,6 @@ impl CircularMembrane {
             tension_n_per_m: self.tension_n_per_m * ratio * ratio,
             ..self.clone()
         }
-    }
-
-    pub(super) fn validate(&self) -> Result<(), ShapeError> {
-        super::check_positive("radius_m", self.radius_m)?;
-        super::check_positive("thickness_m", self.thickness_m)?;
-        super::check_positive("tension_n_per_m", self.tension_n_per_m)
     }
 
     /// The lowest modes within the limits, shapes (unit mean square over the disc) at `coords`.
@@ -112,5 +135,79 @@ impl CircularMembrane {
             });
         }
         modes
+    }
+}
+
+impl Object for CircularMembrane {
+    fn display_kind(&self) -> &'static str {
+        "circular membrane"
+    }
+
+    fn validate(&self) -> Result<(), ShapeError> {
+        super::check_positive("radius_m", self.radius_m)?;
+        super::check_positive("thickness_m", self.thickness_m)?;
+        super::check_positive("tension_n_per_m", self.tension_n_per_m)
+    }
+
+    fn check_proportions(&self) -> Result<(), ShapeError> {
+        check_thin(
+            "thickness_m",
+            self.thickness_m,
+            2.0 * self.radius_m,
+            "diameter",
+        )
+    }
+
+    fn root_hz(&self, material: &Material) -> f64 {
+        self.fundamental_hz(material)
+    }
+
+    fn tuned(&self, material: &Material, root_hz: f64) -> Result<Shape, ShapeError> {
+        Ok(self.tuned_to(material, root_hz).into())
+    }
+
+    fn modes_at(
+        &self,
+        material: &Material,
+        positions: &[Position],
+        limits: &ModeLimits,
+    ) -> Result<Vec<ShapedMode>, ShapeError> {
+        Ok(self.shaped_modes(material, &plane_coords(positions, true)?, limits))
+    }
+
+    fn default_positions(&self) -> Vec<Position> {
+        vec![
+            position("centre", &[0.0, 0.0]),
+            position("half radius", &[0.5, 0.0]),
+            position("two-thirds radius", &DISC_STRIKE),
+            position("near rim", &[0.9, 0.0]),
+        ]
+    }
+
+    fn typical_strike(&self) -> Vec<f64> {
+        DISC_STRIKE.to_vec()
+    }
+
+    fn default_hardness_ms(&self, _material: &Material) -> f64 {
+        DRUM_STICK_MS
+    }
+
+    fn dimensions_m(&self) -> Vec<(&'static str, f64)> {
+        vec![("radius", self.radius_m), ("thickness", self.thickness_m)]
+    }
+
+    fn parameters(&self, _material: &Material) -> Map<String, Value> {
+        let mut map = Map::new();
+        map.insert("tension_n_per_m".into(), json!(self.tension_n_per_m));
+        map
+    }
+
+    fn size(&self) -> String {
+        format!(
+            "{} mm radius, {:.2} mm film at {:.0} N/m",
+            mm(self.radius_m),
+            self.thickness_m * 1e3,
+            self.tension_n_per_m
+        )
     }
 }

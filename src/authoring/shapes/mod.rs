@@ -12,6 +12,11 @@
 //!
 //! Modes at or above [`ModeLimits::max_freq_hz`] are dropped, and only the lowest
 //! [`ModeLimits::max_modes`] are kept.
+//!
+//! Each kind of object is one file holding all there is to it: its parameters and modes, how it
+//! is struck, tuned and described (the `Object` trait of `shape.rs`), and its entry on the command
+//! line ([`ObjectKind`]: name, dimensions and their typical values, default material). One line
+//! of the registry below makes it a [`Shape`] and lists it in [`OBJECTS`].
 
 pub mod bar;
 pub mod bell;
@@ -28,22 +33,39 @@ pub mod plate;
 mod positions;
 pub mod rect_membrane;
 mod shape;
-mod shape_describe;
 pub mod string;
+pub mod triangle;
 
-pub use bar::{Bar, TunedBar, MARIMBA_RATIOS, VIBRAPHONE_RATIOS, XYLOPHONE_RATIOS};
+pub use bar::{Bar, TunedBar, BAR_TUNINGS, MARIMBA_RATIOS, VIBRAPHONE_RATIOS, XYLOPHONE_RATIOS};
 pub use bell::{BellPartial, TunedBell, TUNED_BELL_PARTIALS};
 pub use bowl::Bowl;
+pub use cantilever::Cantilever;
 pub use circular_plate::{CircularPlate, PlateEdge};
 pub use design::{design_bank, BankDesign};
 pub use membrane::CircularMembrane;
-pub use objects::{Dimension, ObjectKind, ObjectSpec, BAR_TUNINGS, OBJECTS};
+pub use objects::{Dimension, ObjectKind, ObjectOption, ObjectSpec};
 pub use plate::RectangularPlate;
 pub use rect_membrane::RectangularMembrane;
-pub use shape::Shape;
-pub use string::StretchedString;
+pub use string::{IdealString, StiffString, StretchedString};
 
-pub(crate) use shape_describe::solid_contact_ms;
+pub(crate) use shape::solid_contact_ms;
+
+// The registry: `Variant(Parameters) => ObjectKind`, one line for each kind of object, in the
+// order `modal-resonator shape --help` lists them.
+shape::register_shapes! {
+    IdealString(IdealString) => string::IDEAL_STRING,
+    StiffString(StiffString) => string::STIFF_STRING,
+    FreeFreeBar(Bar) => bar::FREE_FREE_BAR,
+    ClampedFreeBar(Cantilever) => cantilever::CLAMPED_FREE_BAR,
+    TunedBar(TunedBar) => bar::TUNED_BAR,
+    CircularMembrane(CircularMembrane) => membrane::CIRCULAR_MEMBRANE,
+    RectangularMembrane(RectangularMembrane) => rect_membrane::RECTANGULAR_MEMBRANE,
+    RectangularPlate(RectangularPlate) => plate::RECTANGULAR_PLATE,
+    CircularPlate(CircularPlate) => circular_plate::CIRCULAR_PLATE,
+    Bell(TunedBell) => bell::BELL,
+    Bowl(Bowl) => bowl::BOWL,
+    Triangle(triangle::Triangle) => triangle::TRIANGLE,
+}
 
 use crate::authoring::materials::{Material, AIR_DAMPING_PER_S};
 use crate::bank::{Bank, BankDefaults, Mode, Position};

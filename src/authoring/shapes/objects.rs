@@ -1,13 +1,10 @@
 //! The analytic objects by name, with the dimensions each takes and typical values for those not
-//! given: what `modal-resonator shape` offers and an editor can list. [`ObjectSpec::shape`] turns
-//! a name and named dimensions into a [`Shape`].
+//! given: what `modal-resonator shape` offers and an editor can list. Each kind of object declares
+//! its [`ObjectKind`] in its own file; [`ObjectSpec::shape`] turns a name and named dimensions
+//! into a [`Shape`].
 
-use super::{
-    Bar, Bowl, CircularMembrane, CircularPlate, PlateEdge, RectangularMembrane, RectangularPlate,
-    Shape, ShapeError, StretchedString, TunedBar, TunedBell, MARIMBA_RATIOS, VIBRAPHONE_RATIOS,
-    XYLOPHONE_RATIOS,
-};
-use crate::authoring::materials::{self, Material};
+use super::{PlateEdge, Shape, ShapeError, OBJECTS};
+use crate::authoring::materials::Material;
 
 /// A dimension or parameter an object is given by.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -51,136 +48,50 @@ impl Dimension {
     }
 }
 
-/// An object `modal-resonator shape` can build.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// An option other than a dimension that only some objects take.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ObjectOption {
+    /// The frequencies of a tuned bar's first modes ([`ObjectSpec::tuning`]).
+    Tuning,
+    /// How a circular plate's rim is held ([`ObjectSpec::edge`]).
+    Edge,
+}
+
+impl ObjectOption {
+    /// Lowercase name, as on the command line (`--tuning`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Tuning => "tuning",
+            Self::Edge => "edge",
+        }
+    }
+}
+
+/// An object `modal-resonator shape` can build: each kind of object declares its own, in its
+/// file, and registers it in `mod.rs`.
+#[derive(Debug)]
 pub struct ObjectKind {
-    /// Name on the command line, the same as [`Shape::kind`].
+    /// Name on the command line and in bank sources ([`Shape::kind`]).
     pub name: &'static str,
     /// What it is, in a few words.
     pub about: &'static str,
     /// The dimensions it takes, each with its unit and a typical value used when not given.
     pub dimensions: &'static [(Dimension, &'static str, f64)],
+    /// The options other than dimensions it takes.
+    pub options: &'static [ObjectOption],
     /// The material it is made of when none is given.
     pub default_material: &'static Material,
+    /// The object from a spec whose dimensions and options it takes (given or typical); the
+    /// values are checked afterwards.
+    pub build: fn(&ObjectSpec) -> Shape,
 }
 
-/// Every object, in the order they are listed.
-pub const OBJECTS: &[ObjectKind] = &[
-    ObjectKind {
-        name: "ideal-string",
-        about: "string without stiffness: harmonic partials",
-        dimensions: STRING_DIMENSIONS,
-        default_material: &materials::STEEL,
-    },
-    ObjectKind {
-        name: "stiff-string",
-        about: "piano-like wire: partials stretched by stiffness",
-        dimensions: STRING_DIMENSIONS,
-        default_material: &materials::STEEL,
-    },
-    ObjectKind {
-        name: "free-free-bar",
-        about: "uniform bar free at both ends (glockenspiel): 1 : 2.756 : 5.404",
-        dimensions: &[
-            (Dimension::Length, "m", 0.3),
-            (Dimension::Width, "m", 0.03),
-            (Dimension::Thickness, "m", 0.01),
-        ],
-        default_material: &materials::STEEL,
-    },
-    ObjectKind {
-        name: "clamped-free-bar",
-        about: "bar clamped at one end (kalimba tine, tuning fork prong): 1 : 6.267 : 17.55",
-        dimensions: &[
-            (Dimension::Length, "m", 0.06),
-            (Dimension::Width, "m", 0.004),
-            (Dimension::Thickness, "m", 0.0012),
-        ],
-        default_material: &materials::STEEL,
-    },
-    ObjectKind {
-        name: "tuned-bar",
-        about: "undercut bar with tuned overtones (--tuning marimba, vibraphone, xylophone)",
-        dimensions: &[
-            (Dimension::Length, "m", 0.38),
-            (Dimension::Width, "m", 0.06),
-            (Dimension::Thickness, "m", 0.009),
-        ],
-        default_material: &materials::ROSEWOOD,
-    },
-    ObjectKind {
-        name: "circular-membrane",
-        about: "drum head fixed at its rim: Bessel-zero partials",
-        dimensions: &[
-            (Dimension::Radius, "m", 0.165),
-            (Dimension::Thickness, "m", 0.25e-3),
-            (Dimension::Tension, "N/m", 1400.0),
-        ],
-        default_material: &materials::MYLAR,
-    },
-    ObjectKind {
-        name: "rectangular-membrane",
-        about: "rectangular head fixed at its frame (seed 000 section 3.1)",
-        dimensions: &[
-            (Dimension::Length, "m", 0.4),
-            (Dimension::Width, "m", 0.3),
-            (Dimension::Thickness, "m", 0.2e-3),
-            (Dimension::Tension, "N/m", 2000.0),
-        ],
-        default_material: &materials::MYLAR,
-    },
-    ObjectKind {
-        name: "rectangular-plate",
-        about: "thin plate with hinged edges: a dense metallic wash",
-        dimensions: &[
-            (Dimension::Length, "m", 0.4),
-            (Dimension::Width, "m", 0.3),
-            (Dimension::Thickness, "m", 0.002),
-        ],
-        default_material: &materials::STEEL,
-    },
-    ObjectKind {
-        name: "circular-plate",
-        about: "thin disc, free or clamped at its rim (--edge): gong, cymbal, saucer",
-        dimensions: &[
-            (Dimension::Radius, "m", 0.15),
-            (Dimension::Thickness, "m", 0.002),
-        ],
-        default_material: &materials::BRASS,
-    },
-    ObjectKind {
-        name: "bell",
-        about: "tuned church bell: hum, prime, tierce, quint, nominal",
-        dimensions: &[
-            (Dimension::Diameter, "m", 0.6),
-            (Dimension::Thickness, "m", 0.046),
-        ],
-        default_material: &materials::BRONZE,
-    },
-    ObjectKind {
-        name: "bowl",
-        about: "open bowl or glass rung at its rim: singing bowl, wine glass, cup",
-        dimensions: &[
-            (Dimension::Diameter, "m", 0.2),
-            (Dimension::Thickness, "m", 0.004),
-        ],
-        default_material: &materials::BRONZE,
-    },
-];
-
-/// Dimensions of a string: a plain steel piano wire at middle C by default.
-const STRING_DIMENSIONS: &[(Dimension, &str, f64)] = &[
-    (Dimension::Length, "m", 0.62),
-    (Dimension::Diameter, "m", 1.0e-3),
-    (Dimension::Tension, "N", 650.0),
-];
-
-/// Named tunings of a tuned bar.
-pub const BAR_TUNINGS: [(&str, &[f64]); 3] = [
-    ("marimba", &MARIMBA_RATIOS),
-    ("vibraphone", &VIBRAPHONE_RATIOS),
-    ("xylophone", &XYLOPHONE_RATIOS),
-];
+/// Two entries are the same object when they have the same name.
+impl PartialEq for ObjectKind {
+    fn eq(&self, other: &Self) -> bool {
+        self.name == other.name
+    }
+}
 
 impl ObjectKind {
     /// The object called `name` (any case).
@@ -188,11 +99,17 @@ impl ObjectKind {
         OBJECTS
             .iter()
             .find(|object| object.name.eq_ignore_ascii_case(name.trim()))
+            .copied()
     }
 
     /// Every object's name.
     pub fn names() -> Vec<&'static str> {
         OBJECTS.iter().map(|object| object.name).collect()
+    }
+
+    /// Whether the object takes `option`.
+    pub fn takes_option(&self, option: ObjectOption) -> bool {
+        self.options.contains(&option)
     }
 
     /// Whether the object takes `dimension`.
@@ -238,7 +155,7 @@ impl ObjectSpec {
     }
 
     /// The value of `dimension`: given, or typical.
-    fn value(&self, dimension: Dimension) -> f64 {
+    pub fn value(&self, dimension: Dimension) -> f64 {
         self.dimensions
             .iter()
             .rev()
@@ -267,77 +184,32 @@ impl ObjectSpec {
                 });
             }
         }
-        if self.tuning.is_some() && name != "tuned-bar" {
-            return Err(not_taken("tuning", name, "tuned-bar"));
+        let given = [
+            (ObjectOption::Tuning, self.tuning.is_some()),
+            (ObjectOption::Edge, self.edge.is_some()),
+        ];
+        for (option, is_given) in given {
+            if is_given && !self.object.takes_option(option) {
+                return Err(not_taken(option, name));
+            }
         }
-        if self.edge.is_some() && name != "circular-plate" {
-            return Err(not_taken("edge", name, "circular-plate"));
-        }
-        let v = |dimension| self.value(dimension);
-        let bar = || Bar {
-            length_m: v(Dimension::Length),
-            width_m: v(Dimension::Width),
-            thickness_m: v(Dimension::Thickness),
-        };
-        let string = || StretchedString {
-            length_m: v(Dimension::Length),
-            diameter_m: v(Dimension::Diameter),
-            tension_n: v(Dimension::Tension),
-        };
-        let shape = match name {
-            "ideal-string" => Shape::IdealString(string()),
-            "stiff-string" => Shape::StiffString(string()),
-            "free-free-bar" => Shape::FreeFreeBar(bar()),
-            "clamped-free-bar" => Shape::ClampedFreeBar(bar()),
-            "tuned-bar" => Shape::TunedBar(TunedBar {
-                bar: bar(),
-                tuned_ratios: self
-                    .tuning
-                    .clone()
-                    .unwrap_or_else(|| MARIMBA_RATIOS.to_vec()),
-            }),
-            "circular-membrane" => Shape::CircularMembrane(CircularMembrane {
-                radius_m: v(Dimension::Radius),
-                thickness_m: v(Dimension::Thickness),
-                tension_n_per_m: v(Dimension::Tension),
-            }),
-            "rectangular-membrane" => Shape::RectangularMembrane(RectangularMembrane {
-                length_x_m: v(Dimension::Length),
-                length_y_m: v(Dimension::Width),
-                thickness_m: v(Dimension::Thickness),
-                tension_n_per_m: v(Dimension::Tension),
-            }),
-            "rectangular-plate" => Shape::RectangularPlate(RectangularPlate {
-                length_x_m: v(Dimension::Length),
-                length_y_m: v(Dimension::Width),
-                thickness_m: v(Dimension::Thickness),
-            }),
-            "circular-plate" => Shape::CircularPlate(CircularPlate {
-                radius_m: v(Dimension::Radius),
-                thickness_m: v(Dimension::Thickness),
-                edge: self.edge.unwrap_or(PlateEdge::Free),
-            }),
-            "bell" => Shape::Bell(TunedBell {
-                diameter_m: v(Dimension::Diameter),
-                thickness_m: v(Dimension::Thickness),
-            }),
-            "bowl" => Shape::Bowl(Bowl {
-                diameter_m: v(Dimension::Diameter),
-                thickness_m: v(Dimension::Thickness),
-            }),
-            _ => unreachable!("every object in OBJECTS has a shape"),
-        };
+        let shape = (self.object.build)(self);
         shape.validate()?;
         Ok(shape)
     }
 }
 
-/// The error for an option the object does not take.
-fn not_taken(option: &'static str, object: &str, only: &str) -> ShapeError {
+/// The error for an option the object does not take, naming those that do.
+fn not_taken(option: ObjectOption, object: &str) -> ShapeError {
+    let takers: Vec<&str> = OBJECTS
+        .iter()
+        .filter(|kind| kind.takes_option(option))
+        .map(|kind| kind.name)
+        .collect();
     ShapeError::BadParameter {
-        name: option,
+        name: option.name(),
         value: f64::NAN,
-        reason: format!("only {only} takes it, not {object}"),
+        reason: format!("only {} takes it, not {object}", takers.join(" or ")),
     }
 }
 
@@ -381,5 +253,14 @@ mod tests {
             Shape::FreeFreeBar(b) => assert_eq!((b.length_m, b.width_m), (0.2, 0.03)),
             other => panic!("{other:?}"),
         }
+        // An option only another object takes names that object.
+        let spec = ObjectSpec {
+            tuning: Some(vec![1.0, 4.0]),
+            ..ObjectSpec::typical(bar)
+        };
+        assert_eq!(
+            spec.shape().unwrap_err().to_string(),
+            "tuning = NaN: only tuned-bar takes it, not free-free-bar"
+        );
     }
 }

@@ -9,14 +9,39 @@
 //! Positions are `(x / a, y / b)`, fractions of the sides from a corner.
 
 use super::lattice::lowest_lattice_modes;
-use super::{ModeLimits, ShapeError, ShapedMode};
-use crate::authoring::materials::Material;
+use super::objects::{Dimension, ObjectKind};
+use super::positions::{plane_coords, rectangle_positions, RECTANGLE_STRIKE};
+use super::shape::{mm, Object};
+use super::{check_thin, ModeLimits, Shape, ShapeError, ShapedMode};
+use crate::authoring::materials::{self, Material};
+use crate::bank::Position;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 /// Shapes are scaled by 2 so that their mean square over the plate is 1.
 const UNIT_MEAN_SQUARE_SCALE: f64 = 2.0;
 
+/// `rectangular-plate` on the command line.
+pub static RECTANGULAR_PLATE: ObjectKind = ObjectKind {
+    name: "rectangular-plate",
+    about: "thin plate with hinged edges: a dense metallic wash",
+    dimensions: &[
+        (Dimension::Length, "m", 0.4),
+        (Dimension::Width, "m", 0.3),
+        (Dimension::Thickness, "m", 0.002),
+    ],
+    options: &[],
+    default_material: &materials::STEEL,
+    build: |spec| {
+        Shape::RectangularPlate(RectangularPlate {
+            length_x_m: spec.value(Dimension::Length),
+            length_y_m: spec.value(Dimension::Width),
+            thickness_m: spec.value(Dimension::Thickness),
+        })
+    },
+};
+
 /// A flat rectangular plate of uniform thickness, simply supported (hinged) on all four edges.
+/// Positions: `(x, y)` in fractions of the sides from a corner.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RectangularPlate {
     /// Side along x in m.
@@ -59,12 +84,6 @@ impl RectangularPlate {
         }
     }
 
-    pub(super) fn validate(&self) -> Result<(), ShapeError> {
-        super::check_positive("length_x_m", self.length_x_m)?;
-        super::check_positive("length_y_m", self.length_y_m)?;
-        super::check_positive("thickness_m", self.thickness_m)
-    }
-
     /// Approximate number of modes below `freq_hz`: the quarter ellipse
     /// `(m / a)^2 + (n / b)^2 < 2 f / (pi k)` holds `a b f / (2 k)` lattice points.
     fn approx_mode_count(&self, material: &Material, freq_hz: f64) -> f64 {
@@ -102,5 +121,64 @@ impl RectangularPlate {
                     .collect(),
             })
             .collect()
+    }
+}
+
+impl Object for RectangularPlate {
+    fn display_kind(&self) -> &'static str {
+        "rectangular plate"
+    }
+
+    fn validate(&self) -> Result<(), ShapeError> {
+        super::check_positive("length_x_m", self.length_x_m)?;
+        super::check_positive("length_y_m", self.length_y_m)?;
+        super::check_positive("thickness_m", self.thickness_m)
+    }
+
+    fn check_proportions(&self) -> Result<(), ShapeError> {
+        let shorter_m = self.length_x_m.min(self.length_y_m);
+        check_thin("thickness_m", self.thickness_m, shorter_m, "shorter side")
+    }
+
+    fn root_hz(&self, material: &Material) -> f64 {
+        self.fundamental_hz(material)
+    }
+
+    fn tuned(&self, material: &Material, root_hz: f64) -> Result<Shape, ShapeError> {
+        Ok(self.tuned_to(material, root_hz).into())
+    }
+
+    fn modes_at(
+        &self,
+        material: &Material,
+        positions: &[Position],
+        limits: &ModeLimits,
+    ) -> Result<Vec<ShapedMode>, ShapeError> {
+        Ok(self.shaped_modes(material, &plane_coords(positions, false)?, limits))
+    }
+
+    fn default_positions(&self) -> Vec<Position> {
+        rectangle_positions()
+    }
+
+    fn typical_strike(&self) -> Vec<f64> {
+        RECTANGLE_STRIKE.to_vec()
+    }
+
+    fn dimensions_m(&self) -> Vec<(&'static str, f64)> {
+        vec![
+            ("length_x", self.length_x_m),
+            ("length_y", self.length_y_m),
+            ("thickness", self.thickness_m),
+        ]
+    }
+
+    fn size(&self) -> String {
+        format!(
+            "{} x {} x {} mm",
+            mm(self.length_x_m),
+            mm(self.length_y_m),
+            mm(self.thickness_m)
+        )
     }
 }

@@ -11,6 +11,20 @@ pub(super) fn position(name: &str, coords: &[f64]) -> Position {
     }
 }
 
+/// Where a rectangle (a plate, a frame drum) is usually struck: off-centre, away from the
+/// nodal lines of the low modes.
+pub(super) const RECTANGLE_STRIKE: [f64; 2] = [0.38, 0.42];
+
+/// Positions on a rectangle, from its centre out to a corner.
+pub(super) fn rectangle_positions() -> Vec<Position> {
+    vec![
+        position("centre", &[0.5, 0.5]),
+        position("off-centre", &RECTANGLE_STRIKE),
+        position("near edge", &[0.5, 0.1]),
+        position("near corner", &[0.1, 0.12]),
+    ]
+}
+
 /// The error for `position`, number `index` in its list.
 fn bad_position(index: usize, position: &Position, reason: String) -> ShapeError {
     ShapeError::BadPosition {

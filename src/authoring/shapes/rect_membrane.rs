@@ -12,8 +12,13 @@
 //! Positions are `(x / Lx, y / Ly)`, fractions of the sides from a corner.
 
 use super::lattice::lowest_lattice_modes;
-use super::{ModeLimits, ShapeError, ShapedMode};
-use crate::authoring::materials::Material;
+use super::objects::{Dimension, ObjectKind};
+use super::positions::{plane_coords, rectangle_positions, RECTANGLE_STRIKE};
+use super::shape::{mm, Object, DRUM_STICK_MS};
+use super::{check_thin, ModeLimits, Shape, ShapeError, ShapedMode};
+use crate::authoring::materials::{self, Material};
+use crate::bank::Position;
+use serde_json::{json, Map, Value};
 use std::f64::consts::PI;
 
 /// Shapes are scaled by 2 so that their mean square over the membrane is 1.
@@ -22,7 +27,30 @@ const UNIT_MEAN_SQUARE_SCALE: f64 = 2.0;
 /// The first search bound over the fundamental: enough for a few dozen modes, widened as needed.
 const FIRST_BOUND_OVER_FUNDAMENTAL: f64 = 8.0;
 
-/// A rectangular membrane under uniform tension, fixed along its four edges.
+/// `rectangular-membrane` on the command line.
+pub static RECTANGULAR_MEMBRANE: ObjectKind = ObjectKind {
+    name: "rectangular-membrane",
+    about: "rectangular head fixed at its frame (seed 000 section 3.1)",
+    dimensions: &[
+        (Dimension::Length, "m", 0.4),
+        (Dimension::Width, "m", 0.3),
+        (Dimension::Thickness, "m", 0.2e-3),
+        (Dimension::Tension, "N/m", 2000.0),
+    ],
+    options: &[],
+    default_material: &materials::MYLAR,
+    build: |spec| {
+        Shape::RectangularMembrane(RectangularMembrane {
+            length_x_m: spec.value(Dimension::Length),
+            length_y_m: spec.value(Dimension::Width),
+            thickness_m: spec.value(Dimension::Thickness),
+            tension_n_per_m: spec.value(Dimension::Tension),
+        })
+    },
+};
+
+/// A rectangular membrane under uniform tension, fixed along its four edges: a rectangular drum
+/// head. Positions: `(x, y)` in fractions of the sides from a corner.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RectangularMembrane {
     /// Side along x in m.
@@ -63,13 +91,6 @@ impl RectangularMembrane {
         }
     }
 
-    pub(super) fn validate(&self) -> Result<(), ShapeError> {
-        super::check_positive("length_x_m", self.length_x_m)?;
-        super::check_positive("length_y_m", self.length_y_m)?;
-        super::check_positive("thickness_m", self.thickness_m)?;
-        super::check_positive("tension_n_per_m", self.tension_n_per_m)
-    }
-
     /// The lowest modes within the limits, shapes (unit mean square) at `coords`.
     pub(super) fn shaped_modes(
         &self,
@@ -97,5 +118,76 @@ impl RectangularMembrane {
                     .collect(),
             })
             .collect()
+    }
+}
+
+impl Object for RectangularMembrane {
+    fn display_kind(&self) -> &'static str {
+        "rectangular membrane"
+    }
+
+    fn validate(&self) -> Result<(), ShapeError> {
+        super::check_positive("length_x_m", self.length_x_m)?;
+        super::check_positive("length_y_m", self.length_y_m)?;
+        super::check_positive("thickness_m", self.thickness_m)?;
+        super::check_positive("tension_n_per_m", self.tension_n_per_m)
+    }
+
+    fn check_proportions(&self) -> Result<(), ShapeError> {
+        let shorter_m = self.length_x_m.min(self.length_y_m);
+        check_thin("thickness_m", self.thickness_m, shorter_m, "shorter side")
+    }
+
+    fn root_hz(&self, material: &Material) -> f64 {
+        self.fundamental_hz(material)
+    }
+
+    fn tuned(&self, material: &Material, root_hz: f64) -> Result<Shape, ShapeError> {
+        Ok(self.tuned_to(material, root_hz).into())
+    }
+
+    fn modes_at(
+        &self,
+        material: &Material,
+        positions: &[Position],
+        limits: &ModeLimits,
+    ) -> Result<Vec<ShapedMode>, ShapeError> {
+        Ok(self.shaped_modes(material, &plane_coords(positions, false)?, limits))
+    }
+
+    fn default_positions(&self) -> Vec<Position> {
+        rectangle_positions()
+    }
+
+    fn typical_strike(&self) -> Vec<f64> {
+        RECTANGLE_STRIKE.to_vec()
+    }
+
+    fn default_hardness_ms(&self, _material: &Material) -> f64 {
+        DRUM_STICK_MS
+    }
+
+    fn dimensions_m(&self) -> Vec<(&'static str, f64)> {
+        vec![
+            ("length_x", self.length_x_m),
+            ("length_y", self.length_y_m),
+            ("thickness", self.thickness_m),
+        ]
+    }
+
+    fn parameters(&self, _material: &Material) -> Map<String, Value> {
+        let mut map = Map::new();
+        map.insert("tension_n_per_m".into(), json!(self.tension_n_per_m));
+        map
+    }
+
+    fn size(&self) -> String {
+        format!(
+            "{} x {} mm, {:.2} mm film at {:.0} N/m",
+            mm(self.length_x_m),
+            mm(self.length_y_m),
+            self.thickness_m * 1e3,
+            self.tension_n_per_m
+        )
     }
 }

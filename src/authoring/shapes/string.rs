@@ -13,9 +13,57 @@
 //! plucked string would fall as `1/n^2` instead; the finite width and contact time of a real
 //! hammer are left to the engine's mallet model.
 
-use super::{ModeLimits, ShapeError, ShapedMode};
-use crate::authoring::materials::Material;
+use super::objects::{Dimension, ObjectKind, ObjectSpec};
+use super::positions::{line_coords, position};
+use super::shape::{mm, Object};
+use super::{check_thin, ModeLimits, Shape, ShapeError, ShapedMode};
+use crate::authoring::materials::{self, Material};
+use crate::bank::Position;
+use serde_json::{json, Map, Value};
 use std::f64::consts::{PI, SQRT_2};
+
+/// Mallet contact time for strings, in ms: felt piano hammers stay on the string for roughly
+/// 1-4 ms from treble to bass (Fletcher & Rossing ch. 12).
+const STRING_HAMMER_MS: f64 = 1.5;
+
+/// Where a piano hammer strikes: an eighth of the string.
+const HAMMER_STRIKE: f64 = 0.125;
+
+/// Dimensions of a string: a plain steel piano wire at middle C by default.
+const STRING_DIMENSIONS: &[(Dimension, &str, f64)] = &[
+    (Dimension::Length, "m", 0.62),
+    (Dimension::Diameter, "m", 1.0e-3),
+    (Dimension::Tension, "N", 650.0),
+];
+
+/// `ideal-string` on the command line.
+pub static IDEAL_STRING: ObjectKind = ObjectKind {
+    name: "ideal-string",
+    about: "string without stiffness: harmonic partials",
+    dimensions: STRING_DIMENSIONS,
+    options: &[],
+    default_material: &materials::STEEL,
+    build: |spec| Shape::IdealString(IdealString(StretchedString::from_spec(spec))),
+};
+
+/// `stiff-string` on the command line.
+pub static STIFF_STRING: ObjectKind = ObjectKind {
+    name: "stiff-string",
+    about: "piano-like wire: partials stretched by stiffness",
+    dimensions: STRING_DIMENSIONS,
+    options: &[],
+    default_material: &materials::STEEL,
+    build: |spec| Shape::StiffString(StiffString(StretchedString::from_spec(spec))),
+};
+
+/// A string without stiffness: harmonic partials. Positions: one coordinate, fraction of the
+/// length.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IdealString(pub StretchedString);
+
+/// A piano-like wire: partials stretched by stiffness. Positions as for the ideal string.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StiffString(pub StretchedString);
 
 /// A round solid wire stretched between two fixed points.
 #[derive(Debug, Clone, PartialEq)]
@@ -88,7 +136,16 @@ impl StretchedString {
         })
     }
 
-    pub(super) fn validate(&self) -> Result<(), ShapeError> {
+    /// The string of `spec`'s dimensions.
+    fn from_spec(spec: &ObjectSpec) -> Self {
+        Self {
+            length_m: spec.value(Dimension::Length),
+            diameter_m: spec.value(Dimension::Diameter),
+            tension_n: spec.value(Dimension::Tension),
+        }
+    }
+
+    fn validate(&self) -> Result<(), ShapeError> {
         super::check_positive("length_m", self.length_m)?;
         super::check_positive("diameter_m", self.diameter_m)?;
         super::check_positive("tension_n", self.tension_n)
@@ -96,7 +153,7 @@ impl StretchedString {
 
     /// Modes up to the limits, with shapes `sqrt(2) sin(n pi x)` (unit mean square) at `coords`
     /// (fractions of the length).
-    pub(super) fn shaped_modes(
+    fn shaped_modes(
         &self,
         material: &Material,
         stiff: bool,
@@ -116,5 +173,156 @@ impl StretchedString {
             modes.push(ShapedMode { freq_hz, shape });
         }
         modes
+    }
+}
+
+impl StretchedString {
+    /// Positions along the string, from near an end to the middle.
+    fn default_positions() -> Vec<Position> {
+        vec![
+            position("near the end", &[0.04]),
+            position("one eighth", &[HAMMER_STRIKE]),
+            position("one fifth", &[0.2]),
+            position("middle", &[0.5]),
+        ]
+    }
+
+    /// "620.0 mm long, 1.0 mm wire at 650 N".
+    fn size(&self) -> String {
+        format!(
+            "{} mm long, {} mm wire at {:.0} N",
+            mm(self.length_m),
+            mm(self.diameter_m),
+            self.tension_n
+        )
+    }
+
+    /// The modes of the string, stiff or not, at `positions`.
+    fn modes_at(
+        &self,
+        material: &Material,
+        stiff: bool,
+        positions: &[Position],
+        limits: &ModeLimits,
+    ) -> Result<Vec<ShapedMode>, ShapeError> {
+        Ok(self.shaped_modes(material, stiff, &line_coords(positions)?, limits))
+    }
+}
+
+impl Object for IdealString {
+    fn display_kind(&self) -> &'static str {
+        "ideal string"
+    }
+
+    fn validate(&self) -> Result<(), ShapeError> {
+        self.0.validate()
+    }
+
+    fn check_proportions(&self) -> Result<(), ShapeError> {
+        check_thin("diameter_m", self.0.diameter_m, self.0.length_m, "length")
+    }
+
+    fn root_hz(&self, material: &Material) -> f64 {
+        self.0.mode_freq_hz(material, false, 1)
+    }
+
+    fn tuned(&self, material: &Material, root_hz: f64) -> Result<Shape, ShapeError> {
+        Ok(IdealString(self.0.tuned_to(material, false, root_hz)?).into())
+    }
+
+    fn modes_at(
+        &self,
+        material: &Material,
+        positions: &[Position],
+        limits: &ModeLimits,
+    ) -> Result<Vec<ShapedMode>, ShapeError> {
+        self.0.modes_at(material, false, positions, limits)
+    }
+
+    fn default_positions(&self) -> Vec<Position> {
+        StretchedString::default_positions()
+    }
+
+    fn typical_strike(&self) -> Vec<f64> {
+        vec![HAMMER_STRIKE]
+    }
+
+    fn default_hardness_ms(&self, _material: &Material) -> f64 {
+        STRING_HAMMER_MS
+    }
+
+    fn dimensions_m(&self) -> Vec<(&'static str, f64)> {
+        vec![("length", self.0.length_m), ("diameter", self.0.diameter_m)]
+    }
+
+    fn parameters(&self, _material: &Material) -> Map<String, Value> {
+        let mut map = Map::new();
+        map.insert("tension_n".into(), json!(self.0.tension_n));
+        map
+    }
+
+    fn size(&self) -> String {
+        self.0.size()
+    }
+}
+
+impl Object for StiffString {
+    fn display_kind(&self) -> &'static str {
+        "stiff string"
+    }
+
+    fn validate(&self) -> Result<(), ShapeError> {
+        self.0.validate()
+    }
+
+    fn check_proportions(&self) -> Result<(), ShapeError> {
+        check_thin("diameter_m", self.0.diameter_m, self.0.length_m, "length")
+    }
+
+    fn root_hz(&self, material: &Material) -> f64 {
+        self.0.mode_freq_hz(material, true, 1)
+    }
+
+    fn tuned(&self, material: &Material, root_hz: f64) -> Result<Shape, ShapeError> {
+        Ok(StiffString(self.0.tuned_to(material, true, root_hz)?).into())
+    }
+
+    fn modes_at(
+        &self,
+        material: &Material,
+        positions: &[Position],
+        limits: &ModeLimits,
+    ) -> Result<Vec<ShapedMode>, ShapeError> {
+        self.0.modes_at(material, true, positions, limits)
+    }
+
+    fn default_positions(&self) -> Vec<Position> {
+        StretchedString::default_positions()
+    }
+
+    fn typical_strike(&self) -> Vec<f64> {
+        vec![HAMMER_STRIKE]
+    }
+
+    fn default_hardness_ms(&self, _material: &Material) -> f64 {
+        STRING_HAMMER_MS
+    }
+
+    fn dimensions_m(&self) -> Vec<(&'static str, f64)> {
+        vec![("length", self.0.length_m), ("diameter", self.0.diameter_m)]
+    }
+
+    fn parameters(&self, material: &Material) -> Map<String, Value> {
+        let mut map = Map::new();
+        map.insert("tension_n".into(), json!(self.0.tension_n));
+        map.insert(
+            "inharmonicity".into(),
+            json!(self.0.inharmonicity(material)),
+        );
+        map
+    }
+
+    fn size(&self) -> String {
+        self.0.size()
     }
 }

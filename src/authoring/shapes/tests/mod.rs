@@ -75,8 +75,8 @@ fn piano_wire() -> StretchedString {
 /// One of each kind of shape, with a material that suits it.
 fn every_shape() -> Vec<(Shape, &'static Material)> {
     vec![
-        (Shape::IdealString(piano_wire()), steel()),
-        (Shape::StiffString(piano_wire()), steel()),
+        (Shape::IdealString(IdealString(piano_wire())), steel()),
+        (Shape::StiffString(StiffString(piano_wire())), steel()),
         (glockenspiel_bar(), steel()),
         (
             Shape::TunedBar(TunedBar {
@@ -106,11 +106,11 @@ fn every_shape() -> Vec<(Shape, &'static Material)> {
 }
 
 fn kalimba_tine() -> Shape {
-    Shape::ClampedFreeBar(Bar {
+    Shape::ClampedFreeBar(Cantilever(Bar {
         length_m: 0.06,
         width_m: 0.004,
         thickness_m: 1.2e-3,
-    })
+    }))
 }
 
 fn frame_drum() -> Shape {
@@ -133,7 +133,7 @@ fn disc(edge: PlateEdge) -> Shape {
 #[test]
 fn striking_a_node_silences_the_mode() {
     // A string struck at its middle has no even harmonics.
-    let modes = Shape::IdealString(piano_wire())
+    let modes = Shape::IdealString(IdealString(piano_wire()))
         .modes(steel(), &on_line(&[0.5]), &ModeLimits::default())
         .unwrap();
     for (i, mode) in modes.iter().enumerate() {
@@ -286,11 +286,11 @@ fn tuning_hits_the_requested_pitch() {
         }
     }
     // A wire too stiff for its pitch cannot be tuned by tension.
-    let stubborn = Shape::StiffString(StretchedString {
+    let stubborn = Shape::StiffString(StiffString(StretchedString {
         length_m: 0.05,
         diameter_m: 3e-3,
         tension_n: 100.0,
-    });
+    }));
     assert!(matches!(
         stubborn.tuned_to(steel(), 50.0),
         Err(ShapeError::CannotTune { .. })

@@ -98,7 +98,7 @@ fn stiff_string_follows_the_inharmonicity_formula() {
     let b = std::f64::consts::PI.powi(3) * 200e9 * 1e-12 / (64.0 * 650.0 * 0.62 * 0.62);
     assert!((f0 - 261.85).abs() < 0.01, "f0 = {f0}");
     assert!((b - 3.878e-4).abs() < 1e-6, "B = {b}");
-    let modes = Shape::StiffString(wire)
+    let modes = Shape::StiffString(StiffString(wire))
         .modes(steel(), &on_line(&[0.125]), &ModeLimits::default())
         .unwrap();
     for (i, mode) in modes.iter().enumerate() {
@@ -120,7 +120,7 @@ fn stiff_string_follows_the_inharmonicity_formula() {
 #[test]
 fn ideal_string_is_harmonic_with_struck_string_gains() {
     let x_p = 0.125;
-    let modes = Shape::IdealString(piano_wire())
+    let modes = Shape::IdealString(IdealString(piano_wire()))
         .modes(steel(), &on_line(&[x_p]), &ModeLimits::default())
         .unwrap();
     let f1 = modes[0].freq_hz;
