@@ -2,6 +2,7 @@
 
 use super::{key, FactoryObject, Tweaks};
 use crate::authoring::materials;
+use crate::authoring::shapes::triangle::Triangle;
 use crate::authoring::shapes::{
     Bar, Cantilever, IdealString, Shape, StiffString, StretchedString, TunedBar, MARIMBA_RATIOS,
     VIBRAPHONE_RATIOS, XYLOPHONE_RATIOS,
@@ -191,6 +192,20 @@ pub(super) fn objects() -> Vec<FactoryObject> {
                 hardness_ms: Some(FORK_ON_RUBBER_MS),
                 ..Tweaks::NONE
             },
+        },
+        FactoryObject {
+            name: "Steel triangle",
+            description: "An orchestral triangle: a 10 mm steel rod bent into three sides, hung \
+                          from a corner and struck on its bottom side with a steel beater: a \
+                          bright, long ring whose inharmonic partials (1 : 2.76 : 5.40) blur \
+                          its pitch.",
+            shape: Shape::Triangle(Triangle {
+                length_m: 0.54,
+                diameter_m: 0.01,
+            }),
+            material: &materials::STEEL,
+            root_key: key::D3,
+            tweaks: Tweaks::NONE,
         },
     ]
 }

@@ -25,7 +25,7 @@ macro_rules! analytic {
 }
 
 /// The analytic banks, in display order.
-pub const ANALYTIC_PRESETS: [AnalyticPreset; 27] = [
+pub const ANALYTIC_PRESETS: [AnalyticPreset; 28] = [
     analytic!("ideal-string.json"),
     analytic!("piano-like-stiff-string.json"),
     analytic!("steel-free-free-bar.json"),
@@ -37,6 +37,7 @@ pub const ANALYTIC_PRESETS: [AnalyticPreset; 27] = [
     analytic!("aluminium-chime-bar.json"),
     analytic!("kalimba-tine.json"),
     analytic!("steel-tuning-fork.json"),
+    analytic!("steel-triangle.json"),
     analytic!("circular-membrane.json"),
     analytic!("steel-plate.json"),
     analytic!("glass-plate.json"),
