@@ -20,6 +20,7 @@ mod controls;
 mod expression;
 mod midi;
 mod mix;
+mod mode_fade;
 mod pitch_level;
 mod position;
 mod prepared;

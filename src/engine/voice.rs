@@ -2,8 +2,8 @@
 
 use std::f64::consts::TAU;
 
+use super::mode_fade::fade_samples;
 use super::prepared::PreparedBank;
-use super::pruning::fade_samples;
 use super::{NoteExpression, VoiceModulation, MAX_EXPRESSION_SEMITONES};
 use crate::bank::format::MAX_FREQ_RATIO;
 use crate::dsp::coeffs::ModeCoeffs;
