@@ -17,6 +17,7 @@
 
 mod budget;
 mod controls;
+mod crossfade;
 mod expression;
 mod midi;
 mod mix;
@@ -39,10 +40,11 @@ pub use controls::{
     NUMERIC_CONTROLS, PLAYBACK_LEVEL_RANGE_DB_SPL, VARIATION_CENTS, VARIATION_DECAY,
     VARIATION_GAIN_DB,
 };
+pub use crossfade::BankCrossfade;
 pub use expression::{ControlChange, Controllers};
 pub use midi::{bend_of, MidiInput, MidiMessage, CHANNELS, MPE_MANAGER_CHANNEL, SLIDE_CC};
 pub use mix::{
-    mix_to_mono, Bypass, DryWet, FadeOut, OnsetTrigger, BANK_CROSSFADE_S, BYPASS_FADE_S,
+    mix_to_mono, Bypass, DryWet, OnsetTrigger, OutputStage, BANK_CROSSFADE_S, BYPASS_FADE_S,
 };
 pub use position::{PositionMap, PositionWeights, StrikeAxis};
 pub use prepared::{PreparedBank, TARGET_PEAK};
