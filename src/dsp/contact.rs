@@ -156,6 +156,18 @@ pub const RUB_DC_HZ: f64 = 5.0;
 /// rubbed at the fastest speed, 3 m/s, peak near -2.5 dBFS, at 0.1 m/s near -33 dBFS.
 const RUB_M_PER_S_PER_UNIT: f32 = 4.0;
 
+/// The motion of a contact held with a note, as a player chooses it; [`ContactKind`] is the
+/// contact it plays, with its size.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContactMotion {
+    /// Sliding along the surface ([`ContactKind::Scrape`]).
+    Scrape,
+    /// Rolling on it ([`ContactKind::Roll`]).
+    Roll,
+    /// Rubbing it ([`ContactKind::Rub`]).
+    Rub,
+}
+
 /// How an object touches the surface.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ContactKind {

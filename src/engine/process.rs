@@ -1,7 +1,7 @@
 //! The audio-thread half of the engine: events, control ticks and rendering.
 
 use super::*;
-use crate::dsp::contact::ContactKind;
+use crate::dsp::contact::{ContactKind, ContactMotion};
 use crate::dsp::masking::DB_PER_NEPER;
 use crate::dsp::ExciterKind;
 
@@ -487,20 +487,20 @@ impl Engine {
         if start_dormant || self.voices[i].modes.num_dormant() > 0 {
             self.settle_strike(i, kind, amplitude, len);
         }
-        if kind.is_contact() {
-            self.start_contact(i, kind, amplitude, hardness_ms);
+        if let Some(motion) = kind.contact() {
+            self.start_contact(i, motion, amplitude, hardness_ms);
         }
     }
 
-    /// Starts voice `i`'s contact of `kind` (a scrape, roll or rub) at velocity-derived force
-    /// `amplitude`, its width from `hardness_ms`. A note released at the sample it started
-    /// (a click on the strike pad, a note of no length) lets go of it at once.
-    fn start_contact(&mut self, i: usize, kind: ExciterKind, amplitude: f32, hardness_ms: f32) {
+    /// Starts voice `i`'s contact moving as `motion` at velocity-derived force `amplitude`, its
+    /// width from `hardness_ms`. A note released at the sample it started (a click on the
+    /// strike pad, a note of no length) lets go of it at once.
+    fn start_contact(&mut self, i: usize, motion: ContactMotion, amplitude: f32, hardness_ms: f32) {
         let c = &self.expressed;
         let v = &mut self.voices[i];
         v.contact_velocity = amplitude;
         let (speed, force) = contact_targets(c, v);
-        let shape = contact_shape(c, kind, hardness_ms);
+        let shape = contact_shape(c, motion, hardness_ms);
         v.exciter
             .start_contact(shape, c.roughness, self.sample_rate_hz, speed, force);
         if v.state != VoiceState::Held {
@@ -723,16 +723,16 @@ fn vary_gains(variation: f32, rng: &mut Rng, gains: &mut [f32]) {
 /// a quarter of a millimetre (a corner at 2 kHz at 0.5 m/s), a soft 5 ms through 5 mm.
 const SCRAPE_WIDTH_M_PER_MS: f64 = 1e-3;
 
-/// The contact a note of exciter `kind` (a contact) plays, at hardness `hardness_ms`.
-fn contact_shape(c: &Controls, kind: ExciterKind, hardness_ms: f32) -> ContactKind {
-    match kind {
-        ExciterKind::Roll => ContactKind::Roll {
-            radius_m: c.rolling_radius_mm as f64 * 1e-3,
-        },
-        ExciterKind::Rub => ContactKind::Rub,
-        _ => ContactKind::Scrape {
+/// The contact a note held with `motion` plays, at hardness `hardness_ms`.
+fn contact_shape(c: &Controls, motion: ContactMotion, hardness_ms: f32) -> ContactKind {
+    match motion {
+        ContactMotion::Scrape => ContactKind::Scrape {
             width_m: hardness_ms as f64 * SCRAPE_WIDTH_M_PER_MS,
         },
+        ContactMotion::Roll => ContactKind::Roll {
+            radius_m: c.rolling_radius_mm as f64 * 1e-3,
+        },
+        ContactMotion::Rub => ContactKind::Rub,
     }
 }
 

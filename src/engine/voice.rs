@@ -256,7 +256,8 @@ impl Voice {
         start_dormant: bool,
     ) {
         let pitch = tuning.log_pitch.exp();
-        let bound = amplitude * kind.peak_bound(len_samples);
+        let knock = kind.knock();
+        let bound = amplitude * knock.peak_bound(len_samples);
         let threshold = start_threshold(threshold, bank.num_modes());
         let heard = |gain: f32| gain.abs() * bound >= threshold;
         // A strike point reaches some of a bank's modes only (one object of a scene): runs of
@@ -278,7 +279,7 @@ impl Voice {
         // A contact is started by the engine, which knows its controls. A key struck again while
         // its contact goes on knocks the object (a mallet strike), and the contact goes on.
         if !kind.is_contact() || self.exciter.holds_contact() {
-            self.exciter.strike(kind, amplitude, len_samples);
+            self.exciter.strike(knock, amplitude, len_samples);
         }
     }
 
