@@ -197,6 +197,8 @@ pub enum NoteExpression {
     /// Slide 0 to 1 (MPE's CC 74, CLAP's brightness): the speed of a contact note, from still
     /// to the fastest contact speed.
     Slide(f32),
+    /// The speed of a contact note in m/s (a rendered note's speed curve), as a slide sets it.
+    ContactSpeed(f32),
 }
 
 /// A control one voice holds in place of the engine's, in the same units as [`Controls`].

@@ -201,8 +201,6 @@ pub struct Exciter {
     /// Whether the contact under way has been let go: it ends once its force has died away. A
     /// contact held at no force carries on (a player may press again).
     contact_released: bool,
-    /// Where the contact's speed is going, m/s.
-    contact_speed: f32,
     /// Where the contact's normal force is going, 0 to 1.
     contact_force: f32,
     /// Noise source, reseeded on reset so output repeats.
@@ -227,7 +225,6 @@ impl Exciter {
             contact: Contact::new(ContactKind::Scrape { width_m: 1e-3 }, 0.5, seed, 48_000.0),
             in_contact: false,
             contact_released: false,
-            contact_speed: 0.0,
             contact_force: 0.0,
             rng: Rng::new(seed),
             seed,
@@ -271,7 +268,7 @@ impl Exciter {
         }
         self.in_contact = true;
         self.contact_released = false;
-        self.contact_speed = speed_m_per_s;
+        self.contact.set_speed(speed_m_per_s);
         self.contact_force = force;
     }
 
@@ -279,7 +276,7 @@ impl Exciter {
     /// go.
     pub fn set_contact(&mut self, speed_m_per_s: f32, force: f32) {
         if !self.contact_released {
-            self.contact_speed = speed_m_per_s;
+            self.contact.set_speed(speed_m_per_s);
             self.contact_force = force;
         }
     }
@@ -318,8 +315,7 @@ impl Exciter {
         if !self.is_rubbing() {
             return 0.0;
         }
-        self.contact
-            .rub(self.contact_speed, self.contact_force, velocity, gain_sum)
+        self.contact.rub(self.contact_force, velocity, gain_sum)
     }
 
     /// How many strikes are under way.
@@ -373,8 +369,7 @@ impl Exciter {
         }
         out.fill(0.0);
         if self.in_contact {
-            self.contact
-                .render(self.contact_speed, CONTACT_GAIN * self.contact_force, out);
+            self.contact.render(CONTACT_GAIN * self.contact_force, out);
             if self.contact_released && self.contact.is_silent() {
                 self.in_contact = false;
             }

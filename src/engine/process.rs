@@ -394,7 +394,7 @@ impl Engine {
         v.tuning_semitones = 0.0;
         v.pressure = 0.0;
         v.pressed = false;
-        v.slide = None;
+        v.speed_m_per_s = None;
         v.overrides = VoiceOverrides::default();
         v.state = VoiceState::Held;
         v.pending_strike = Some(PendingStrike { velocity, fresh });
@@ -736,16 +736,15 @@ fn contact_shape(c: &Controls, motion: ContactMotion, hardness_ms: f32) -> Conta
     }
 }
 
-/// Where a contact note's speed (m/s) and force are going: the note's slide, else its own
-/// contact speed (polyphonic modulation), else the contact speed; the note's own pressure once it
+/// Where a contact note's speed (m/s) and force are going: the note's own speed (its slide),
+/// else its own contact speed (polyphonic modulation), else the contact speed; the note's own pressure once it
 /// has pressed, else its own or the engine's contact force (which the channel's pressure or mod
 /// wheel may set) times its velocity.
 fn contact_targets(c: &Controls, v: &Voice) -> (f32, f32) {
     let o = &v.overrides;
-    let speed = v.slide.map_or(
-        o.contact_speed_m_per_s.unwrap_or(c.contact_speed_m_per_s),
-        |s| s * CONTACT_SPEED_MAX_M_PER_S,
-    );
+    let speed = v
+        .speed_m_per_s
+        .unwrap_or(o.contact_speed_m_per_s.unwrap_or(c.contact_speed_m_per_s));
     let force = if v.pressed {
         v.pressure
     } else {
