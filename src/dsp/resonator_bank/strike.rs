@@ -166,44 +166,90 @@ impl ResonatorBank {
         due: bool,
         mut gain_of: impl FnMut(usize) -> f32,
     ) -> usize {
-        let now = self.clock;
-        // Forget pulses that have ended; what is left of the others, and for how long.
-        let mut kept = 0;
-        let mut span = pulse.samples() as u64;
-        let mut reach = pulse.amplitude.abs();
-        let mut earlier = [(0, Prepared::NONE); MAX_PULSES];
-        for k in 0..self.num_pulses {
-            let (start, old) = self.pulses[k];
-            let end = start + old.samples() as u64;
-            if end > now {
-                self.pulses[kept] = self.pulses[k];
-                earlier[kept] = ((now - start) as u32, old.prepared());
-                span = span.max(end - now);
-                reach += old.amplitude.abs();
-                kept += 1;
-            }
-        }
-        if kept == MAX_PULSES {
-            self.pulses.rotate_left(1);
-            earlier.rotate_left(1);
-            kept -= 1;
-        }
-        self.pulses[kept] = (now, pulse);
-        self.num_pulses = kept + 1;
+        let under_way = self.note_pulse(pulse);
         // Noted even with no dormant modes: a mode this pulse is still playing into when a later
         // strike starts it dormant takes the rest of it.
         if self.num_dormant == 0 {
             return 0;
         }
+        let (n, num_waking) = self.refer_to_records(pulse, &under_way, due, &mut gain_of);
+        let scratch = &mut self.absorb;
+        scratch.run(n);
+        for k in 0..n {
+            let d = &mut self.dormant[scratch.record[k] as usize];
+            d.re = scratch.out_re[k];
+            d.im = scratch.out_im[k];
+            d.snap_db = scratch.out_db[k];
+        }
+        if due {
+            self.earliest_recheck = self.earliest_recheck.min(self.clock);
+        }
+        // Woken as though before this pulse (their old ringing, less what it has not played of
+        // the earlier pulses, fades back in), with this strike's gain; last first, so the
+        // records moved into the places of those woken have been passed already.
+        self.num_pulses = under_way.kept;
+        for k in (0..num_waking).rev() {
+            let r = self.absorb.waking[k] as usize;
+            let mode = self.dormant[r].mode as usize;
+            self.wake_record(r);
+            let slot = self.slot_of_mode[mode] as usize;
+            self.gain[slot] = gain_of(mode);
+        }
+        self.num_pulses = under_way.kept + 1;
+        n
+    }
+
+    /// Notes `pulse`, starting now, among the pulses under way, forgetting those that have
+    /// ended (and the oldest, if there are too many); returns what is left of the earlier ones.
+    fn note_pulse(&mut self, pulse: Pulse) -> UnderWay {
+        let now = self.clock;
+        let mut u = UnderWay {
+            kept: 0,
+            span: pulse.samples() as u64,
+            reach: pulse.amplitude.abs(),
+            earlier: [(0, Prepared::NONE); MAX_PULSES],
+        };
+        for k in 0..self.num_pulses {
+            let (start, old) = self.pulses[k];
+            let end = start + old.samples() as u64;
+            if end > now {
+                self.pulses[u.kept] = self.pulses[k];
+                u.earlier[u.kept] = ((now - start) as u32, old.prepared());
+                u.span = u.span.max(end - now);
+                u.reach += old.amplitude.abs();
+                u.kept += 1;
+            }
+        }
+        if u.kept == MAX_PULSES {
+            self.pulses.rotate_left(1);
+            u.earlier.rotate_left(1);
+            u.kept -= 1;
+        }
+        self.pulses[u.kept] = (now, pulse);
+        self.num_pulses = u.kept + 1;
+        u
+    }
+
+    /// Brings each dormant record to now and works out its share of `pulse` (and, at a change
+    /// of gain, of the pulses `under_way`) into the scratch, for its arithmetic to run over all
+    /// of them at once. Records of modes too damped to refer the pulses back to now are listed
+    /// to be woken instead. Returns how many records took it and how many are to be woken.
+    fn refer_to_records(
+        &mut self,
+        pulse: Pulse,
+        under_way: &UnderWay,
+        due: bool,
+        gain_of: &mut impl FnMut(usize) -> f32,
+    ) -> (usize, usize) {
+        let now = self.clock;
         let unit = Pulse {
             amplitude: 1.0,
             ..pulse
         };
         let prepared = unit.prepared();
         let key = (pulse.shape, unit.samples());
-        // Each record is brought to now and its share of the pulse worked out; the arithmetic
-        // of the new states then runs over all of them at once.
-        // Modes too damped to refer the pulses back to now are computed through them instead.
+        let span = under_way.span;
+        let earlier = &under_way.earlier[..under_way.kept];
         let too_damped = MAX_ABSORB_NEPERS / span as f64;
         let (mut n, mut num_waking) = (0, 0);
         for r in 0..self.num_dormant {
@@ -224,18 +270,15 @@ impl ResonatorBank {
             let gain = gain_of(d.mode as usize);
             let p = Complex64::new(d.p_re, d.p_im);
             let response = self.responses[d.mode as usize].get(p, key, &prepared);
-            let mut added = response.scale(pulse.amplitude as f64 * gain as f64);
             let change = gain as f64 - d.gain as f64;
             let bounded = d.pulse_left > 0 || d.delta * span as f64 > BOUND_NEPERS;
-            // What the earlier pulses have still to play, at unit gain, referred back to now.
-            let mut rest = Complex64::ZERO;
-            if change != 0.0 || bounded {
-                for &(played, old) in &earlier[..kept] {
-                    rest = rest + powi(p, played) * old.response(p, played, u32::MAX);
-                }
-            }
-            // It now comes with this strike's gain.
-            added = added + rest.scale(change);
+            let rest = if change != 0.0 || bounded {
+                still_to_play(p, earlier)
+            } else {
+                Complex64::ZERO
+            };
+            // What the earlier pulses have still to play now comes with this strike's gain.
+            let added = response.scale(pulse.amplitude as f64 * gain as f64) + rest.scale(change);
             scratch.phase[n] = d.phase;
             scratch.log_gain[n] = d.log_gain;
             scratch.re[n] = d.re;
@@ -251,7 +294,7 @@ impl ResonatorBank {
             if bounded {
                 let (re, im) = d.state();
                 let truth = Complex64::new(re as f64, im as f64) - rest.scale(d.gain as f64);
-                let peak = truth.norm_sqr().sqrt() as f32 + gain.abs() * reach;
+                let peak = truth.norm_sqr().sqrt() as f32 + gain.abs() * under_way.reach;
                 d.pulse_peak_db = power_to_db(peak * peak);
                 d.pulse_left = span as u32;
             }
@@ -262,30 +305,7 @@ impl ResonatorBank {
                 self.recheck[r] = now;
             }
         }
-        let scratch = &mut self.absorb;
-        scratch.run(n);
-        for k in 0..n {
-            let d = &mut self.dormant[scratch.record[k] as usize];
-            d.re = scratch.out_re[k];
-            d.im = scratch.out_im[k];
-            d.snap_db = scratch.out_db[k];
-        }
-        if due {
-            self.earliest_recheck = self.earliest_recheck.min(now);
-        }
-        // Woken as though before this pulse (their old ringing, less what it has not played of
-        // the earlier pulses, fades back in), with this strike's gain; last first, so the
-        // records moved into the places of those woken have been passed already.
-        self.num_pulses = kept;
-        for k in (0..num_waking).rev() {
-            let r = self.absorb.waking[k] as usize;
-            let mode = self.dormant[r].mode as usize;
-            self.wake_record(r);
-            let slot = self.slot_of_mode[mode] as usize;
-            self.gain[slot] = gain_of(mode);
-        }
-        self.num_pulses = kept + 1;
-        n
+        (n, num_waking)
     }
 
     /// How many of the pulses given to [`ResonatorBank::absorb_strike`] are still playing.
@@ -355,6 +375,29 @@ impl CachedResponse {
         }
         self.response
     }
+}
+
+/// The pulses under way when a new one comes.
+struct UnderWay {
+    /// How many earlier pulses are still playing.
+    kept: usize,
+    /// Samples from now until the last of them, the new one included, ends.
+    span: u64,
+    /// Sum of their amplitudes' magnitudes, the new one's included.
+    reach: f32,
+    /// Each earlier pulse still playing (the first `kept`): samples it has played, and its
+    /// response constants.
+    earlier: [(u32, Prepared); MAX_PULSES],
+}
+
+/// What the `earlier` pulses (samples played, response constants) have still to play, at unit
+/// gain, referred back to now, for a mode of pole `p`.
+fn still_to_play(p: Complex64, earlier: &[(u32, Prepared)]) -> Complex64 {
+    let mut rest = Complex64::ZERO;
+    for &(played, old) in earlier {
+        rest = rest + powi(p, played) * old.response(p, played, u32::MAX);
+    }
+    rest
 }
 
 /// `z^n` by repeated squaring, from one upward by the bits of `n`.
