@@ -124,31 +124,49 @@ impl Engine {
 
     /// Smoothing steps, truncation, freeing and coefficient updates, every `CONTROL_PERIOD`.
     fn control_tick(&mut self) {
-        let silent = self.is_silent();
-        if silent {
+        self.smooth_damping();
+        self.ramp_width();
+        let input_heard = std::mem::take(&mut self.input_heard);
+        self.tick_voices(input_heard);
+        // Polyphony lowered: fade the quietest voices beyond the limit.
+        let polyphony = self.expressed.polyphony.min(self.capacity);
+        while self.voices.iter().filter(|v| v.is_sounding()).count() > polyphony {
+            let victim = self.quietest_sounding();
+            self.voices[victim].state = VoiceState::Fading;
+        }
+        self.prune_tick(input_heard);
+    }
+
+    /// Steps the damping and its tilt towards their targets (jumps, when nothing sounds), and
+    /// brings the decay table up to date for the voices sounding.
+    fn smooth_damping(&mut self) {
+        if self.is_silent() {
             // Nothing sounds, so nothing can zipper: jump to the targets.
             self.snap_smoothing();
-        } else {
-            let (target_damping, target_tilt) = self.damping_targets();
-            let k = self.tick_coefficient(DAMPING_SMOOTHING_S);
-            let s = &mut self.smoothed;
-            if s.log_damping != target_damping || s.tilt != target_tilt {
-                let tilt_moved = s.tilt != target_tilt;
-                s.log_damping = step_towards(s.log_damping, target_damping, k, 1e-4);
-                s.tilt = step_towards(s.tilt, target_tilt, k, 1e-4);
-                let stale = if tilt_moved {
-                    Stale::Tilt
-                } else {
-                    Stale::Damping
-                };
-                self.decay_stale = self.decay_stale.max(stale);
-            }
-            // Only sounding voices need the table now; a note-on brings it up to date otherwise.
-            if self.decay_stale != Stale::Fresh {
-                self.rebuild_decay_table();
-            }
+            return;
         }
-        // Stereo width: ramp the column weights over the next period.
+        let (target_damping, target_tilt) = self.damping_targets();
+        let k = self.tick_coefficient(DAMPING_SMOOTHING_S);
+        let s = &mut self.smoothed;
+        if s.log_damping != target_damping || s.tilt != target_tilt {
+            let tilt_moved = s.tilt != target_tilt;
+            s.log_damping = step_towards(s.log_damping, target_damping, k, 1e-4);
+            s.tilt = step_towards(s.tilt, target_tilt, k, 1e-4);
+            let stale = if tilt_moved {
+                Stale::Tilt
+            } else {
+                Stale::Damping
+            };
+            self.decay_stale = self.decay_stale.max(stale);
+        }
+        // Only sounding voices need the table now; a note-on brings it up to date otherwise.
+        if self.decay_stale != Stale::Fresh {
+            self.rebuild_decay_table();
+        }
+    }
+
+    /// Stereo width: ramps the column weights over the next period to the width's.
+    fn ramp_width(&mut self) {
         let target = lane_weights(self.expressed.width, &self.bank.column_pan);
         if target != self.smoothed.weights && self.smoothed.weight_ramp_left == 0 {
             let inv = 1.0 / CONTROL_PERIOD as f32;
@@ -159,13 +177,17 @@ impl Engine {
             self.smoothed.weight_target = target;
             self.smoothed.weight_ramp_left = CONTROL_PERIOD;
         }
+    }
 
+    /// Each sounding voice (and the input voice, heard this period if `input_heard`): fades
+    /// finished, modes under the truncation threshold retired (the voice ended when none is
+    /// left), its contact following its targets, its pitch stepped and its modes retuned.
+    fn tick_voices(&mut self, input_heard: bool) {
         let threshold = db_to_gain(self.expressed.truncation_db);
         let pitch_k = self.tick_coefficient(PITCH_SMOOTHING_S);
         let input_key = self
             .last_key
             .unwrap_or(self.bank.root_key.round().clamp(0.0, 127.0) as u8);
-        let input_heard = std::mem::take(&mut self.input_heard);
         let release = self.release_decay();
         let version = self.damping_version;
         let num_voices = self.voices.len();
@@ -222,13 +244,6 @@ impl Engine {
                 v.retune(bank, decay, rate, tuning);
             }
         }
-        // Polyphony lowered: fade the quietest voices beyond the limit.
-        let polyphony = self.expressed.polyphony.min(self.capacity);
-        while self.voices.iter().filter(|v| v.is_sounding()).count() > polyphony {
-            let victim = self.quietest_sounding();
-            self.voices[victim].state = VoiceState::Fading;
-        }
-        self.prune_tick(input_heard);
     }
 
     fn apply_event(&mut self, event: NoteEvent) {
