@@ -142,8 +142,8 @@ fn geometric(u: Complex64, first: Complex64, span: Complex64, a: u32, b: u32) ->
         let mut term = first;
         let mut sum = Complex64::ZERO;
         for _ in a..b {
-            sum = sum + term;
-            term = term * u;
+            sum += term;
+            term *= u;
         }
         return sum;
     }
@@ -329,7 +329,7 @@ impl ResonatorBank {
             }
             // The record holds p^k (z + g sum_all); the truth is p^k (z + g sum_(j<k)).
             let ahead = pulse.prepared().response(p, played as u32, u32::MAX);
-            z = z - (powi(p, played as u32) * ahead).scale(d.gain as f64);
+            z -= (powi(p, played as u32) * ahead).scale(d.gain as f64);
         }
         let (re, im) = (z.re as f32, z.im as f32);
         // A pulse too big to refer back (`absorb_strike` left the mode silent): nothing to undo.
@@ -395,7 +395,7 @@ struct UnderWay {
 fn still_to_play(p: Complex64, earlier: &[(u32, Prepared)]) -> Complex64 {
     let mut rest = Complex64::ZERO;
     for &(played, old) in earlier {
-        rest = rest + powi(p, played) * old.response(p, played, u32::MAX);
+        rest += powi(p, played) * old.response(p, played, u32::MAX);
     }
     rest
 }
@@ -405,7 +405,7 @@ fn powi(z: Complex64, mut n: u32) -> Complex64 {
     let (mut base, mut acc) = (z, Complex64::ONE);
     while n > 0 {
         if n & 1 == 1 {
-            acc = acc * base;
+            acc *= base;
         }
         base = base * base;
         n >>= 1;
