@@ -435,6 +435,27 @@ mod tests {
     }
 
     #[test]
+    fn each_kind_strikes_or_holds_a_contact_under_its_own_name() {
+        let names = ExciterKind::ALL.map(|k| k.name());
+        assert_eq!(
+            names,
+            ["impulse", "mallet", "noise", "scrape", "roll", "rub"]
+        );
+        for kind in ExciterKind::ALL {
+            assert_eq!(ExciterKind::from_name(kind.name()), Some(kind));
+            let contact = matches!(kind.excitation(), Excitation::Contact(_));
+            assert_eq!(kind.is_contact(), contact, "{kind:?}");
+            assert_eq!(kind.contact().is_some(), contact, "{kind:?}");
+            // A contact note's key knocks as a mallet.
+            if let Excitation::Strike(strike) = kind.excitation() {
+                assert_eq!(kind.knock(), strike);
+            } else {
+                assert_eq!(kind.knock(), StrikeKind::Mallet);
+            }
+        }
+    }
+
+    #[test]
     fn a_contact_let_go_is_no_longer_held_while_it_dies_away() {
         let mut e = Exciter::new(7);
         assert!(!e.holds_contact());

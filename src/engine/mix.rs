@@ -313,6 +313,16 @@ mod tests {
     }
 
     #[test]
+    fn the_output_stage_lets_no_subnormal_out() {
+        let mut stage = OutputStage::default();
+        let tiny = f32::MIN_POSITIVE / 4.0;
+        let (mut l, mut r) = (vec![tiny; 64], vec![-tiny; 64]);
+        let dry = vec![tiny; 64];
+        stage.apply([&mut l, &mut r], Some([&dry, &dry]), 0.5, false, true, RATE);
+        assert!(l.iter().chain(&r).all(|&v| v == 0.0), "{l:?} {r:?}");
+    }
+
+    #[test]
     fn strikes_land_at_the_inputs_onsets_in_time_order() {
         let mut trigger = OnsetTrigger::new(RATE);
         // Quiet, then a tap at sample 1000 and another half a second later.
