@@ -17,9 +17,11 @@
 
 mod budget;
 mod controls;
+mod crossfade;
 mod expression;
 mod midi;
 mod mix;
+mod mode_fade;
 mod pitch_level;
 mod position;
 mod prepared;
@@ -38,10 +40,11 @@ pub use controls::{
     NUMERIC_CONTROLS, PLAYBACK_LEVEL_RANGE_DB_SPL, VARIATION_CENTS, VARIATION_DECAY,
     VARIATION_GAIN_DB,
 };
+pub use crossfade::BankCrossfade;
 pub use expression::{ControlChange, Controllers};
 pub use midi::{bend_of, MidiInput, MidiMessage, CHANNELS, MPE_MANAGER_CHANNEL, SLIDE_CC};
 pub use mix::{
-    mix_to_mono, Bypass, DryWet, FadeOut, OnsetTrigger, BANK_CROSSFADE_S, BYPASS_FADE_S,
+    mix_to_mono, Bypass, DryWet, OnsetTrigger, OutputStage, BANK_CROSSFADE_S, BYPASS_FADE_S,
 };
 pub use position::{PositionMap, PositionWeights, StrikeAxis};
 pub use prepared::{PreparedBank, TARGET_PEAK};
@@ -194,6 +197,8 @@ pub enum NoteExpression {
     /// Slide 0 to 1 (MPE's CC 74, CLAP's brightness): the speed of a contact note, from still
     /// to the fastest contact speed.
     Slide(f32),
+    /// The speed of a contact note in m/s (a rendered note's speed curve), as a slide sets it.
+    ContactSpeed(f32),
 }
 
 /// A control one voice holds in place of the engine's, in the same units as [`Controls`].

@@ -439,6 +439,181 @@ fn decibels(name: &str, default: f32, range: (f32, f32)) -> FloatParam {
         .with_rounded_steps(0.1)
 }
 
+impl ObjectParams {
+    /// The object's parameters, with defaults `d` (the default bank's).
+    fn new(d: &Controls) -> Self {
+        Self {
+            size: FloatParam::new(
+                "Size",
+                1.0,
+                FloatRange::SymmetricalSkewed {
+                    min: control_range("size_ratio").0,
+                    max: control_range("size_ratio").1,
+                    factor: FloatRange::skew_factor(-1.0),
+                    center: 1.0,
+                },
+            )
+            .with_unit(" x")
+            .with_rounded_steps(0.001)
+            .with_smoother(SmoothingStyle::None)
+            .with_poly_modulation_id(poly_id::SIZE),
+            key_tracking: percent("Key tracking", d.key_tracking),
+            fine_tune: FloatParam::new("Fine tune", 0.0, linear(control_range("fine_tune_cents")))
+                .with_unit(" ct")
+                .with_rounded_steps(0.1)
+                .with_poly_modulation_id(poly_id::FINE_TUNE),
+            bend_range: FloatParam::new(
+                "Pitch bend range",
+                2.0,
+                linear(control_range("bend_range_semitones")),
+            )
+            .with_unit(" st")
+            .with_rounded_steps(1.0),
+        }
+    }
+}
+
+impl StrikeParams {
+    /// The strike's and contact's parameters, with defaults `d` (the default bank's).
+    fn new(d: &Controls) -> Self {
+        Self {
+            strike_x: percent("Strike position", d.strike_x)
+                .with_poly_modulation_id(poly_id::STRIKE_X),
+            strike_y: percent("Strike position Y", d.strike_y)
+                .with_poly_modulation_id(poly_id::STRIKE_Y),
+            position_variation: percent("Position variation", 0.0),
+            strike_variation: percent("Strike variation", 0.0),
+            exciter: EnumParam::new("Exciter", ExciterChoice::of(d.exciter)),
+            hardness: skewed("Hardness", d.hardness_ms, "hardness_ms", -2.5)
+                .with_unit(" ms")
+                .with_rounded_steps(0.01)
+                .with_poly_modulation_id(poly_id::HARDNESS),
+            velocity_sensitivity: percent("Velocity sensitivity", 0.8),
+            velocity_to_hardness: percent("Velocity to hardness", 0.5),
+            roughness: percent("Roughness", d.roughness),
+            rolling_radius: skewed(
+                "Rolling radius",
+                d.rolling_radius_mm,
+                "rolling_radius_mm",
+                -1.5,
+            )
+            .with_unit(" mm")
+            .with_rounded_steps(0.1),
+            contact_speed: skewed(
+                "Contact speed",
+                d.contact_speed_m_per_s,
+                "contact_speed_m_per_s",
+                -1.0,
+            )
+            .with_unit(" m/s")
+            .with_rounded_steps(0.01)
+            .with_poly_modulation_id(poly_id::CONTACT_SPEED),
+            contact_force: percent("Contact force", d.contact_force)
+                .with_poly_modulation_id(poly_id::CONTACT_FORCE),
+        }
+    }
+}
+
+impl MaterialParams {
+    /// The material's parameters, with defaults `d` (the default bank's).
+    fn new(d: &Controls) -> Self {
+        Self {
+            material: EnumParam::new("Material", MaterialChoice::Authored),
+            material_q: FloatParam::new(
+                "Q",
+                1000.0,
+                FloatRange::Skewed {
+                    min: MATERIAL_Q_RANGE.0,
+                    max: MATERIAL_Q_RANGE.1,
+                    factor: FloatRange::skew_factor(-2.0),
+                },
+            )
+            .with_rounded_steps(1.0),
+            damping_tilt: FloatParam::new(
+                "Damping tilt",
+                d.damping_tilt,
+                linear(control_range("damping_tilt")),
+            )
+            .with_rounded_steps(0.01),
+            release_damping: percent("Release damping", 0.0),
+        }
+    }
+}
+
+impl VoiceParams {
+    /// The voices' parameters.
+    fn new() -> Self {
+        Self {
+            polyphony: IntParam::new(
+                "Polyphony",
+                16,
+                IntRange::Linear {
+                    min: 1,
+                    max: MAX_POLYPHONY as i32,
+                },
+            ),
+            truncation: decibels(
+                "Truncation threshold",
+                -96.0,
+                control_range("truncation_db"),
+            ),
+            mod_wheel_target: EnumParam::new("Mod wheel", ExpressionTarget::Position),
+            pressure_target: EnumParam::new("Pressure", ExpressionTarget::Damping),
+            mpe: BoolParam::new("MPE", false),
+            mpe_bend_range: FloatParam::new(
+                "MPE bend range",
+                MPE_DEFAULT_BEND_RANGE,
+                linear(control_range("mpe_bend_range_semitones")),
+            )
+            .with_unit(" st")
+            .with_rounded_steps(1.0),
+        }
+    }
+}
+
+impl OutputParams {
+    /// The output's parameters; an effect's (`is_effect`) is half wet.
+    fn new(is_effect: bool) -> Self {
+        Self {
+            output_gain: decibels("Output gain", 0.0, control_range("output_gain_db")),
+            width: percent("Stereo width", 0.5),
+            dry_wet: percent("Dry/wet", if is_effect { 0.5 } else { 1.0 }),
+        }
+    }
+}
+
+impl InputParams {
+    /// The audio input's parameters; an effect's (`is_effect`) drives the modes.
+    fn new(is_effect: bool) -> Self {
+        Self {
+            input_mode: EnumParam::new(
+                "Input mode",
+                if is_effect {
+                    InputMode::Direct
+                } else {
+                    InputMode::Off
+                },
+            ),
+            input_gain: decibels(
+                "Input gain",
+                if is_effect { -24.0 } else { 0.0 },
+                control_range("input_gain_db"),
+            ),
+            trigger_threshold: decibels("Trigger threshold", -30.0, TRIGGER_THRESHOLD_RANGE_DB),
+            retrigger: FloatParam::new(
+                "Retrigger time",
+                50.0,
+                FloatRange::Linear {
+                    min: 5.0,
+                    max: 500.0,
+                },
+            )
+            .with_unit(" ms")
+            .with_rounded_steps(1.0),
+        }
+    }
+}
+
 impl ModalParams {
     /// The parameters with their defaults; `is_effect` sets defaults that suit the effect (input
     /// driving the modes, half wet).
@@ -450,155 +625,12 @@ impl ModalParams {
             bank: BankField::default(),
             state_format: AtomicU32::new(STATE_FORMAT),
             editor_size: std::sync::RwLock::new(None),
-            object: ObjectParams {
-                size: FloatParam::new(
-                    "Size",
-                    1.0,
-                    FloatRange::SymmetricalSkewed {
-                        min: control_range("size_ratio").0,
-                        max: control_range("size_ratio").1,
-                        factor: FloatRange::skew_factor(-1.0),
-                        center: 1.0,
-                    },
-                )
-                .with_unit(" x")
-                .with_rounded_steps(0.001)
-                .with_smoother(SmoothingStyle::None)
-                .with_poly_modulation_id(poly_id::SIZE),
-                key_tracking: percent("Key tracking", d.key_tracking),
-                fine_tune: FloatParam::new(
-                    "Fine tune",
-                    0.0,
-                    linear(control_range("fine_tune_cents")),
-                )
-                .with_unit(" ct")
-                .with_rounded_steps(0.1)
-                .with_poly_modulation_id(poly_id::FINE_TUNE),
-                bend_range: FloatParam::new(
-                    "Pitch bend range",
-                    2.0,
-                    FloatRange::Linear {
-                        min: 0.0,
-                        max: control_range("pitch_bend_semitones").1,
-                    },
-                )
-                .with_unit(" st")
-                .with_rounded_steps(1.0),
-            },
-            strike: StrikeParams {
-                strike_x: percent("Strike position", d.strike_x)
-                    .with_poly_modulation_id(poly_id::STRIKE_X),
-                strike_y: percent("Strike position Y", d.strike_y)
-                    .with_poly_modulation_id(poly_id::STRIKE_Y),
-                position_variation: percent("Position variation", 0.0),
-                strike_variation: percent("Strike variation", 0.0),
-                exciter: EnumParam::new("Exciter", ExciterChoice::of(d.exciter)),
-                hardness: skewed("Hardness", d.hardness_ms, "hardness_ms", -2.5)
-                    .with_unit(" ms")
-                    .with_rounded_steps(0.01)
-                    .with_poly_modulation_id(poly_id::HARDNESS),
-                velocity_sensitivity: percent("Velocity sensitivity", 0.8),
-                velocity_to_hardness: percent("Velocity to hardness", 0.5),
-                roughness: percent("Roughness", d.roughness),
-                rolling_radius: skewed(
-                    "Rolling radius",
-                    d.rolling_radius_mm,
-                    "rolling_radius_mm",
-                    -1.5,
-                )
-                .with_unit(" mm")
-                .with_rounded_steps(0.1),
-                contact_speed: skewed(
-                    "Contact speed",
-                    d.contact_speed_m_per_s,
-                    "contact_speed_m_per_s",
-                    -1.0,
-                )
-                .with_unit(" m/s")
-                .with_rounded_steps(0.01)
-                .with_poly_modulation_id(poly_id::CONTACT_SPEED),
-                contact_force: percent("Contact force", d.contact_force)
-                    .with_poly_modulation_id(poly_id::CONTACT_FORCE),
-            },
-            material: MaterialParams {
-                material: EnumParam::new("Material", MaterialChoice::Authored),
-                material_q: FloatParam::new(
-                    "Q",
-                    1000.0,
-                    FloatRange::Skewed {
-                        min: MATERIAL_Q_RANGE.0,
-                        max: MATERIAL_Q_RANGE.1,
-                        factor: FloatRange::skew_factor(-2.0),
-                    },
-                )
-                .with_rounded_steps(1.0),
-                damping_tilt: FloatParam::new(
-                    "Damping tilt",
-                    d.damping_tilt,
-                    linear(control_range("damping_tilt")),
-                )
-                .with_rounded_steps(0.01),
-                release_damping: percent("Release damping", 0.0),
-            },
-            voices: VoiceParams {
-                polyphony: IntParam::new(
-                    "Polyphony",
-                    16,
-                    IntRange::Linear {
-                        min: 1,
-                        max: MAX_POLYPHONY as i32,
-                    },
-                ),
-                truncation: decibels(
-                    "Truncation threshold",
-                    -96.0,
-                    control_range("truncation_db"),
-                ),
-                mod_wheel_target: EnumParam::new("Mod wheel", ExpressionTarget::Position),
-                pressure_target: EnumParam::new("Pressure", ExpressionTarget::Damping),
-                mpe: BoolParam::new("MPE", false),
-                mpe_bend_range: FloatParam::new(
-                    "MPE bend range",
-                    MPE_DEFAULT_BEND_RANGE,
-                    FloatRange::Linear {
-                        min: 0.0,
-                        max: 96.0,
-                    },
-                )
-                .with_unit(" st")
-                .with_rounded_steps(1.0),
-            },
-            output: OutputParams {
-                output_gain: decibels("Output gain", 0.0, control_range("output_gain_db")),
-                width: percent("Stereo width", 0.5),
-                dry_wet: percent("Dry/wet", if is_effect { 0.5 } else { 1.0 }),
-            },
-            input: InputParams {
-                input_mode: EnumParam::new(
-                    "Input mode",
-                    if is_effect {
-                        InputMode::Direct
-                    } else {
-                        InputMode::Off
-                    },
-                ),
-                input_gain: decibels(
-                    "Input gain",
-                    if is_effect { -24.0 } else { 0.0 },
-                    control_range("input_gain_db"),
-                ),
-                trigger_threshold: decibels("Trigger threshold", -30.0, TRIGGER_THRESHOLD_RANGE_DB),
-                retrigger: FloatParam::new(
-                    "Retrigger time",
-                    50.0,
-                    FloatRange::Linear {
-                        min: 5.0,
-                        max: 500.0,
-                    },
-                )
-                .with_unit(" ms")
-                .with_rounded_steps(1.0),
-            },
+            object: ObjectParams::new(&d),
+            strike: StrikeParams::new(&d),
+            material: MaterialParams::new(&d),
+            voices: VoiceParams::new(),
+            output: OutputParams::new(is_effect),
+            input: InputParams::new(is_effect),
             bypass: BoolParam::new("Bypass", false).make_bypass(),
             pruning: PruningParams::new(&d),
         }
@@ -714,6 +746,7 @@ mod tests {
             for (param, control) in [
                 (&p.object.size, "size_ratio"),
                 (&p.object.fine_tune, "fine_tune_cents"),
+                (&p.object.bend_range, "bend_range_semitones"),
                 (&p.strike.hardness, "hardness_ms"),
                 (&p.strike.roughness, "roughness"),
                 (&p.strike.rolling_radius, "rolling_radius_mm"),
@@ -721,6 +754,7 @@ mod tests {
                 (&p.strike.contact_force, "contact_force"),
                 (&p.material.damping_tilt, "damping_tilt"),
                 (&p.voices.truncation, "truncation_db"),
+                (&p.voices.mpe_bend_range, "mpe_bend_range_semitones"),
                 (&p.output.output_gain, "output_gain_db"),
                 (&p.input.input_gain, "input_gain_db"),
                 (&p.pruning.masking_offset, "masking_offset_db"),
@@ -730,10 +764,6 @@ mod tests {
                 let ends = (param.preview_plain(0.0), param.preview_plain(1.0));
                 assert_eq!(ends, (min, max), "{} and {control}", param.name());
             }
-            assert_eq!(
-                p.object.bend_range.preview_plain(1.0),
-                control_range("pitch_bend_semitones").1
-            );
         }
     }
 

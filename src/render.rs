@@ -21,7 +21,7 @@ pub use wav::{to_int_sample, wav_bytes, write_wav, BitDepth, WavEncoder, WavFile
 use crate::bank::Bank;
 use crate::engine::{
     Controls, Engine, ExciterKind, MidiInput, MidiMessage, NoteEvent, NoteExpression, PositionMap,
-    PreparedBank, CONTACT_SPEED_MAX_M_PER_S,
+    PreparedBank,
 };
 use crate::units::{db_to_gain, gain_to_db};
 
@@ -317,7 +317,7 @@ fn schedule(notes: &[Note], rate: f64, until_s: f64) -> Vec<TimedEvent> {
 /// smoothing, so a ramp is followed without steps.
 const CURVE_STEP_S: f64 = 0.002;
 
-/// A note's contact curves (speed, force) as the note's slide and pressure, from its strike to
+/// A note's contact curves (speed, force) as the note's speed and pressure, from its strike to
 /// its release (or the strike alone, for a note held until it dies away), up to `until_s`.
 fn contact_curves(note: &Note, rate: f64, until_s: f64, events: &mut Vec<TimedEvent>) {
     if note.speed_m_per_s.is_none() && note.force.is_none() || note.time_s > until_s {
@@ -353,7 +353,7 @@ fn contact_curves(note: &Note, rate: f64, until_s: f64, events: &mut Vec<TimedEv
             })
         };
         if let Some(speed) = note.speed_m_per_s {
-            push(NoteExpression::Slide(at(speed) / CONTACT_SPEED_MAX_M_PER_S));
+            push(NoteExpression::ContactSpeed(at(speed)));
         }
         if let Some(force) = note.force {
             push(NoteExpression::Pressure(at(force)));

@@ -156,6 +156,18 @@ pub const RUB_DC_HZ: f64 = 5.0;
 /// rubbed at the fastest speed, 3 m/s, peak near -2.5 dBFS, at 0.1 m/s near -33 dBFS.
 const RUB_M_PER_S_PER_UNIT: f32 = 4.0;
 
+/// The motion of a contact held with a note, as a player chooses it; [`ContactKind`] is the
+/// contact it plays, with its size.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ContactMotion {
+    /// Sliding along the surface ([`ContactKind::Scrape`]).
+    Scrape,
+    /// Rolling on it ([`ContactKind::Roll`]).
+    Roll,
+    /// Rubbing it ([`ContactKind::Rub`]).
+    Rub,
+}
+
 /// How an object touches the surface.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum ContactKind {
@@ -205,6 +217,8 @@ pub struct Contact {
     bump_place: [f64; BUMPS],
     /// Phase of the rolling object, in revolutions `[0, 1)`.
     revolution: f64,
+    /// Where the speed is going, metres per second: finite and not negative.
+    target_speed: f64,
     /// Smoothed speed, metres per second.
     speed: f64,
     /// Smoothed normal force, relative.
@@ -270,6 +284,7 @@ impl Contact {
             bump_height,
             bump_place,
             revolution: 0.0,
+            target_speed: 0.0,
             speed: 0.0,
             force: 0.0,
             low_pass: 0.0,
@@ -312,8 +327,19 @@ impl Contact {
         }
     }
 
+    /// Moves the contact towards `speed_m_per_s` from the next sample, smoothly; non-finite or
+    /// negative speeds count as zero. Every speed a contact plays comes through here.
+    pub fn set_speed(&mut self, speed_m_per_s: f32) {
+        self.target_speed = if speed_m_per_s.is_finite() {
+            speed_m_per_s.max(0.0) as f64
+        } else {
+            0.0
+        };
+    }
+
     /// Lets the contact go at once: force and speed back to zero, the low-pass emptied.
     pub fn reset(&mut self) {
+        self.target_speed = 0.0;
         self.speed = 0.0;
         self.force = 0.0;
         self.low_pass = 0.0;
@@ -327,12 +353,12 @@ impl Contact {
         self.force.abs() < 1e-6
     }
 
-    /// Adds the contact force for the next `out.len()` samples into `out`, as
-    /// speed and force move towards `speed_m_per_s` and `force` (relative, 1 is a firm touch).
-    /// Non-finite or negative inputs count as zero. A rub adds nothing here: its force answers
-    /// the object's motion, sample by sample ([`Contact::rub`]).
-    pub fn render(&mut self, speed_m_per_s: f32, force: f32, out: &mut [f32]) {
-        let (target_speed, target_force) = targets(speed_m_per_s, force);
+    /// Adds the contact force for the next `out.len()` samples into `out`, as speed moves
+    /// towards [`Contact::set_speed`]'s and force towards `force` (relative, 1 is a firm touch;
+    /// non-finite or negative counts as zero). A rub adds nothing here: its force answers the
+    /// object's motion, sample by sample ([`Contact::rub`]).
+    pub fn render(&mut self, force: f32, out: &mut [f32]) {
+        let (target_speed, target_force) = (self.target_speed, sanitized_force(force));
         let k = self.smoothing;
         let dt = 1.0 / self.sample_rate_hz;
         let width_m = match self.kind {
@@ -379,15 +405,15 @@ impl Contact {
         }
     }
 
-    /// A rub's force on the object for the next sample, as speed and force move towards
-    /// `speed_m_per_s` and `force` (relative, 1 is a firm touch; non-finite or negative count as
-    /// zero), given the object's velocity at the contact point now: `velocity`, the sum of its
+    /// A rub's force on the object for the next sample, as speed moves towards
+    /// [`Contact::set_speed`]'s and force towards `force` (relative, 1 is a firm touch;
+    /// non-finite or negative counts as zero), given the object's velocity at the contact point now: `velocity`, the sum of its
     /// modes' velocities with the sign of their gains, and `gain_sum`, the sum of their gains'
     /// magnitudes (how far that velocity moves for a unit force in one sample).
     #[inline]
-    pub fn rub(&mut self, speed_m_per_s: f32, force: f32, velocity: f32, gain_sum: f32) -> f32 {
-        let (target_speed, target_force) = targets(speed_m_per_s, force);
-        let target_speed = target_speed.min(RUB_MAX_SPEED_M_PER_S);
+    pub fn rub(&mut self, force: f32, velocity: f32, gain_sum: f32) -> f32 {
+        let target_speed = self.target_speed.min(RUB_MAX_SPEED_M_PER_S);
+        let target_force = sanitized_force(force);
         let k = self.smoothing;
         // The speed moves as a hand does, at a bounded acceleration.
         let step = self.rub_speed_step;
@@ -481,19 +507,13 @@ fn rub_friction(dv_m_per_s: f32, stick_m_per_s: f32) -> f32 {
     (dv_m_per_s / stick_m_per_s).tanh() * sliding.max(RUB_LEAST)
 }
 
-/// Speed and force targets with non-finite or negative values taken as zero.
-fn targets(speed_m_per_s: f32, force: f32) -> (f64, f32) {
-    let speed = if speed_m_per_s.is_finite() {
-        speed_m_per_s.max(0.0) as f64
-    } else {
-        0.0
-    };
-    let force = if force.is_finite() {
+/// A force target with non-finite or negative values taken as zero.
+fn sanitized_force(force: f32) -> f32 {
+    if force.is_finite() {
         force.max(0.0)
     } else {
         0.0
-    };
-    (speed, force)
+    }
 }
 
 /// RMS of the eased lattice heights over a long path (lattice values uniform in [-1, 1], eased):

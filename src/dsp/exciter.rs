@@ -1,4 +1,5 @@
-//! What strikes the resonators: impulses, mallet force pulses and noise bursts.
+//! What excites the resonators: strikes (impulses, mallet force pulses and noise bursts) and
+//! the contact held with a note (scrape, roll, rub: [`super::contact`]).
 //!
 //! Each strike becomes a short input signal of unit area (impulse, mallet) or unit energy (noise)
 //! times its amplitude, so a mode's response to it has the mode's own amplitude for an impulse.
@@ -6,7 +7,7 @@
 
 use std::f32::consts::TAU;
 
-use super::contact::{Contact, ContactKind};
+use super::contact::{Contact, ContactKind, ContactMotion};
 use super::rng::Rng;
 
 /// Level of a contact's force against a strike's: a scrape at 0.5 m/s and the default force
@@ -18,22 +19,23 @@ const CONTACT_GAIN: f32 = 3.7e-4;
 /// How many overlapping strikes one voice keeps; a further strike replaces the oldest.
 pub const MAX_PULSES: usize = 4;
 
-/// The shape of a strike.
+/// How a note excites the object: one of three strikes, or one of three contacts held with the
+/// note. The exciter control, the plugin's exciter parameter and a bank's `defaults.exciter`
+/// name it ([`ExciterKind::name`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum ExciterKind {
-    /// A single sample: every mode at its full amplitude.
+    /// A single sample ([`StrikeKind::Impulse`]).
     Impulse,
-    /// Raised-cosine force pulse `1 - cos(2 pi t / T)` over the contact time T (van den Doel,
-    /// seed 000 eq. 4.5): short T is a hard, bright mallet, long T a soft, dull one.
+    /// A mallet's force pulse ([`StrikeKind::Mallet`]).
     #[default]
     Mallet,
-    /// White noise under a linearly falling envelope over the contact time: a brush.
+    /// A noise burst: a brush ([`StrikeKind::Noise`]).
     Noise,
-    /// Scraping for as long as the note is held ([`super::contact`]).
+    /// Scraping for as long as the note is held ([`ContactMotion::Scrape`]).
     Scrape,
-    /// Rolling for as long as the note is held ([`super::contact`]).
+    /// Rolling for as long as the note is held ([`ContactMotion::Roll`]).
     Roll,
-    /// Rubbing for as long as the note is held: stick-slip friction ([`super::contact`]).
+    /// Rubbing for as long as the note is held ([`ContactMotion::Rub`]).
     Rub,
 }
 
@@ -65,23 +67,88 @@ impl ExciterKind {
         Self::ALL.into_iter().find(|k| k.name() == name)
     }
 
-    /// Whether the exciter is a contact held with the note (scrape, roll, rub) rather than a
-    /// strike.
+    /// What a note of this kind does: strike the object, or hold a contact on it.
+    pub fn excitation(self) -> Excitation {
+        match self {
+            ExciterKind::Impulse => Excitation::Strike(StrikeKind::Impulse),
+            ExciterKind::Mallet => Excitation::Strike(StrikeKind::Mallet),
+            ExciterKind::Noise => Excitation::Strike(StrikeKind::Noise),
+            ExciterKind::Scrape => Excitation::Contact(ContactMotion::Scrape),
+            ExciterKind::Roll => Excitation::Contact(ContactMotion::Roll),
+            ExciterKind::Rub => Excitation::Contact(ContactMotion::Rub),
+        }
+    }
+
+    /// The contact held with the note, if the note holds one (scrape, roll, rub).
+    pub fn contact(self) -> Option<ContactMotion> {
+        match self.excitation() {
+            Excitation::Strike(_) => None,
+            Excitation::Contact(motion) => Some(motion),
+        }
+    }
+
+    /// Whether the note holds a contact (scrape, roll, rub) rather than striking.
     pub fn is_contact(self) -> bool {
-        matches!(
-            self,
-            ExciterKind::Scrape | ExciterKind::Roll | ExciterKind::Rub
-        )
+        self.contact().is_some()
+    }
+
+    /// The strike a note of this kind gives when its key is struck: its own, or for a contact
+    /// note a knock of a mallet (a key struck again while its contact goes on).
+    pub fn knock(self) -> StrikeKind {
+        match self.excitation() {
+            Excitation::Strike(kind) => kind,
+            Excitation::Contact(_) => StrikeKind::Mallet,
+        }
     }
 
     /// The strike's shape when it is known in full in advance (impulse, mallet); `None` for
     /// noise and contact, whose samples are not. This alone decides what pruning may take
     /// analytically.
     pub fn pulse_shape(self) -> Option<PulseShape> {
+        match self.excitation() {
+            Excitation::Strike(kind) => kind.pulse_shape(),
+            Excitation::Contact(_) => None,
+        }
+    }
+
+    /// Bound on a mode's amplitude after this kind's strike ([`ExciterKind::knock`]) of unit
+    /// amplitude over `len_samples`, relative to its gain ([`StrikeKind::peak_bound`]); a
+    /// contact's own force is not bounded in advance.
+    pub fn peak_bound(self, len_samples: u32) -> f32 {
+        self.knock().peak_bound(len_samples)
+    }
+}
+
+/// What a note does to the object.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Excitation {
+    /// Strikes it once, when the key is struck.
+    Strike(StrikeKind),
+    /// Holds a contact on it for as long as the note is held.
+    Contact(ContactMotion),
+}
+
+/// The shape of a strike: a short input signal of unit area (impulse, mallet) or unit energy
+/// (noise) times its amplitude.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StrikeKind {
+    /// A single sample: every mode at its full amplitude.
+    Impulse,
+    /// Raised-cosine force pulse `1 - cos(2 pi t / T)` over the contact time T (van den Doel,
+    /// seed 000 eq. 4.5): short T is a hard, bright mallet, long T a soft, dull one.
+    Mallet,
+    /// White noise under a linearly falling envelope over the contact time: a brush.
+    Noise,
+}
+
+impl StrikeKind {
+    /// The strike's shape when it is known in full in advance (impulse, mallet); `None` for
+    /// noise, whose samples are not.
+    pub fn pulse_shape(self) -> Option<PulseShape> {
         match self {
-            ExciterKind::Impulse => Some(PulseShape::Impulse),
-            ExciterKind::Mallet => Some(PulseShape::Mallet),
-            ExciterKind::Noise | ExciterKind::Scrape | ExciterKind::Roll | ExciterKind::Rub => None,
+            StrikeKind::Impulse => Some(PulseShape::Impulse),
+            StrikeKind::Mallet => Some(PulseShape::Mallet),
+            StrikeKind::Noise => None,
         }
     }
 
@@ -89,10 +156,8 @@ impl ExciterKind {
     /// unit-area pulses; for noise of `len` samples and unit energy, `sqrt(len)` (Cauchy-Schwarz).
     pub fn peak_bound(self, len_samples: u32) -> f32 {
         match self {
-            ExciterKind::Impulse | ExciterKind::Mallet => 1.0,
-            ExciterKind::Noise => (len_samples.max(1) as f32).sqrt(),
-            // Contacts strike as mallets (a contact's own force is not bounded in advance).
-            ExciterKind::Scrape | ExciterKind::Roll | ExciterKind::Rub => 1.0,
+            StrikeKind::Impulse | StrikeKind::Mallet => 1.0,
+            StrikeKind::Noise => (len_samples.max(1) as f32).sqrt(),
         }
     }
 }
@@ -111,7 +176,7 @@ pub enum PulseShape {
 #[derive(Debug, Clone, Copy)]
 struct StrikeUnderWay {
     /// Shape of the pulse.
-    kind: ExciterKind,
+    kind: StrikeKind,
     /// Scale of the pulse: its area (impulse, mallet) or the square root of its energy (noise).
     amplitude: f32,
     /// Length in samples.
@@ -136,8 +201,6 @@ pub struct Exciter {
     /// Whether the contact under way has been let go: it ends once its force has died away. A
     /// contact held at no force carries on (a player may press again).
     contact_released: bool,
-    /// Where the contact's speed is going, m/s.
-    contact_speed: f32,
     /// Where the contact's normal force is going, 0 to 1.
     contact_force: f32,
     /// Noise source, reseeded on reset so output repeats.
@@ -150,7 +213,7 @@ impl Exciter {
     /// An idle exciter whose noise starts from `seed`.
     pub fn new(seed: u32) -> Self {
         let idle = StrikeUnderWay {
-            kind: ExciterKind::Impulse,
+            kind: StrikeKind::Impulse,
             amplitude: 0.0,
             len: 0,
             pos: 0,
@@ -162,7 +225,6 @@ impl Exciter {
             contact: Contact::new(ContactKind::Scrape { width_m: 1e-3 }, 0.5, seed, 48_000.0),
             in_contact: false,
             contact_released: false,
-            contact_speed: 0.0,
             contact_force: 0.0,
             rng: Rng::new(seed),
             seed,
@@ -206,7 +268,7 @@ impl Exciter {
         }
         self.in_contact = true;
         self.contact_released = false;
-        self.contact_speed = speed_m_per_s;
+        self.contact.set_speed(speed_m_per_s);
         self.contact_force = force;
     }
 
@@ -214,7 +276,7 @@ impl Exciter {
     /// go.
     pub fn set_contact(&mut self, speed_m_per_s: f32, force: f32) {
         if !self.contact_released {
-            self.contact_speed = speed_m_per_s;
+            self.contact.set_speed(speed_m_per_s);
             self.contact_force = force;
         }
     }
@@ -253,8 +315,7 @@ impl Exciter {
         if !self.is_rubbing() {
             return 0.0;
         }
-        self.contact
-            .rub(self.contact_speed, self.contact_force, velocity, gain_sum)
+        self.contact.rub(self.contact_force, velocity, gain_sum)
     }
 
     /// How many strikes are under way.
@@ -263,7 +324,7 @@ impl Exciter {
     }
 
     /// Bound on how much the strikes still under way can add to a mode's amplitude, relative to
-    /// its gain: the sum of their whole pulses' bounds ([`ExciterKind::peak_bound`]).
+    /// its gain: the sum of their whole pulses' bounds ([`StrikeKind::peak_bound`]).
     pub fn pending_bound(&self) -> f32 {
         self.pulses[..self.count]
             .iter()
@@ -272,15 +333,9 @@ impl Exciter {
     }
 
     /// Starts a strike of `amplitude` lasting `len_samples` (at least 1) from the next sample
-    /// rendered. A contact kind strikes as a mallet (contacts start with
-    /// [`Exciter::start_contact`]).
-    pub fn strike(&mut self, kind: ExciterKind, amplitude: f32, len_samples: u32) {
-        let kind = if kind.is_contact() {
-            ExciterKind::Mallet
-        } else {
-            kind
-        };
-        let len = if kind == ExciterKind::Impulse {
+    /// rendered (contacts start with [`Exciter::start_contact`]).
+    pub fn strike(&mut self, kind: StrikeKind, amplitude: f32, len_samples: u32) {
+        let len = if kind == StrikeKind::Impulse {
             1
         } else {
             len_samples.max(1)
@@ -314,8 +369,7 @@ impl Exciter {
         }
         out.fill(0.0);
         if self.in_contact {
-            self.contact
-                .render(self.contact_speed, CONTACT_GAIN * self.contact_force, out);
+            self.contact.render(CONTACT_GAIN * self.contact_force, out);
             if self.contact_released && self.contact.is_silent() {
                 self.in_contact = false;
             }
@@ -325,16 +379,12 @@ impl Exciter {
             let p = &mut self.pulses[i];
             let n = ((p.len - p.pos) as usize).min(out.len());
             match p.kind {
-                ExciterKind::Impulse => {
+                StrikeKind::Impulse => {
                     if n > 0 {
                         out[0] += p.amplitude;
                     }
                 }
-                // Contacts strike as mallets.
-                ExciterKind::Mallet
-                | ExciterKind::Scrape
-                | ExciterKind::Roll
-                | ExciterKind::Rub => {
+                StrikeKind::Mallet => {
                     if p.len == 1 {
                         out[0] += p.amplitude;
                     } else {
@@ -347,7 +397,7 @@ impl Exciter {
                         }
                     }
                 }
-                ExciterKind::Noise => {
+                StrikeKind::Noise => {
                     let inv_len = 1.0 / p.len as f32;
                     for (k, x) in out[..n].iter_mut().enumerate() {
                         let env = 1.0 - (p.pos as usize + k) as f32 * inv_len;
@@ -371,7 +421,7 @@ impl Exciter {
 mod tests {
     use super::*;
 
-    fn total(kind: ExciterKind, len: u32, block: usize) -> (f32, f32) {
+    fn total(kind: StrikeKind, len: u32, block: usize) -> (f32, f32) {
         let mut e = Exciter::new(7);
         e.strike(kind, 0.5, len);
         let mut sum = 0.0;
@@ -382,6 +432,27 @@ mod tests {
             energy += buf.iter().map(|x| x * x).sum::<f32>();
         }
         (sum, energy)
+    }
+
+    #[test]
+    fn each_kind_strikes_or_holds_a_contact_under_its_own_name() {
+        let names = ExciterKind::ALL.map(|k| k.name());
+        assert_eq!(
+            names,
+            ["impulse", "mallet", "noise", "scrape", "roll", "rub"]
+        );
+        for kind in ExciterKind::ALL {
+            assert_eq!(ExciterKind::from_name(kind.name()), Some(kind));
+            let contact = matches!(kind.excitation(), Excitation::Contact(_));
+            assert_eq!(kind.is_contact(), contact, "{kind:?}");
+            assert_eq!(kind.contact().is_some(), contact, "{kind:?}");
+            // A contact note's key knocks as a mallet.
+            if let Excitation::Strike(strike) = kind.excitation() {
+                assert_eq!(kind.knock(), strike);
+            } else {
+                assert_eq!(kind.knock(), StrikeKind::Mallet);
+            }
+        }
     }
 
     #[test]
@@ -407,16 +478,16 @@ mod tests {
     #[test]
     fn pulses_have_unit_area_or_energy_whatever_the_block() {
         for block in [1, 7, 64] {
-            let (area, _) = total(ExciterKind::Impulse, 10, block);
+            let (area, _) = total(StrikeKind::Impulse, 10, block);
             assert!((area - 0.5).abs() < 1e-6, "impulse area {area}");
             for len in [1, 2, 48, 960] {
-                let (area, _) = total(ExciterKind::Mallet, len, block);
+                let (area, _) = total(StrikeKind::Mallet, len, block);
                 assert!(
                     (area - 0.5).abs() < 1e-4,
                     "mallet len {len} block {block}: area {area}"
                 );
             }
-            let (_, energy) = total(ExciterKind::Noise, 4800, block);
+            let (_, energy) = total(StrikeKind::Noise, 4800, block);
             assert!((energy / 0.25 - 1.0).abs() < 0.1, "noise energy {energy}");
         }
     }

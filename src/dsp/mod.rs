@@ -18,6 +18,6 @@ pub mod resonator_bank;
 pub mod rng;
 
 pub use coeffs::ModeCoeffs;
-pub use exciter::{Exciter, ExciterKind};
+pub use exciter::{Excitation, Exciter, ExciterKind, StrikeKind};
 pub use kernels::Kernel;
 pub use resonator_bank::{ResonatorBank, COLUMNS};

@@ -130,6 +130,51 @@ pub fn bend_of(value: f32) -> f32 {
     (value * 2.0 - 1.0).clamp(-1.0, 1.0)
 }
 
+/// How a block's MIDI reaches the notes, as its controls say.
+#[derive(Debug, Clone, Copy)]
+struct Routing {
+    /// MPE (lower zone): member channels' bend, pressure and slide are their notes' own.
+    mpe: bool,
+    /// Semitones of a member channel's full bend.
+    mpe_bend_range_semitones: f32,
+    /// Whether a note's pressure is its own: it damps the note when routed so, and is a
+    /// contact's force whatever the routing.
+    pressure_is_the_notes: bool,
+    /// Whether the notes hold a contact while pressure is routed to damping (which would damp
+    /// the contact instead of pressing it).
+    contact_routed_to_damping: bool,
+}
+
+impl Routing {
+    /// The routing `controls` set.
+    fn of(controls: &Controls) -> Self {
+        let contact = controls.exciter.is_contact();
+        let damping = controls.pressure_target == ExpressionTarget::Damping;
+        Self {
+            mpe: controls.mpe,
+            mpe_bend_range_semitones: controls.mpe_bend_range_semitones,
+            pressure_is_the_notes: contact || damping,
+            contact_routed_to_damping: contact && damping,
+        }
+    }
+
+    /// Whether `channel` is an MPE member channel.
+    fn is_member(self, channel: u8) -> bool {
+        self.mpe && channel != MPE_MANAGER_CHANNEL
+    }
+
+    /// Whether channel pressure on `channel` is its notes' own: on MPE member channels, and,
+    /// without MPE, on a contact when routed to damping.
+    fn channel_pressure_is_the_notes(self, channel: u8) -> bool {
+        self.is_member(channel) || (!self.mpe && self.contact_routed_to_damping)
+    }
+}
+
+/// The index of `channel`'s state.
+fn index(channel: u8) -> usize {
+    channel as usize % CHANNELS
+}
+
 impl MidiInput {
     /// Reads `message` at sample `time`, handing the engine events it makes to `emit`, as
     /// `controls` (their MPE setting, bend range and pressure routing, and exciter) say.
@@ -140,54 +185,15 @@ impl MidiInput {
         controls: &Controls,
         mut emit: impl FnMut(NoteEvent),
     ) {
-        let mpe = controls.mpe;
-        let is_member = |channel: u8| mpe && channel != MPE_MANAGER_CHANNEL;
-        // A note's pressure damps it when routed so, and is a contact's force whatever the
-        // routing.
-        let pressure_is_the_notes =
-            controls.exciter.is_contact() || controls.pressure_target == ExpressionTarget::Damping;
-        let index = |channel: u8| channel as usize % CHANNELS;
-        // Channel pressure is its channel's notes' own: on MPE member channels, and, without
-        // MPE, on a contact when routed to damping (which would damp it instead of pressing).
-        let channel_pressure_is_the_notes = |channel: u8| {
-            is_member(channel)
-                || (!mpe
-                    && controls.exciter.is_contact()
-                    && controls.pressure_target == ExpressionTarget::Damping)
-        };
+        let routing = Routing::of(controls);
+        let emit = &mut emit;
         match message {
             MidiMessage::NoteOn { note, velocity } if velocity > 0.0 => {
-                // Pressed again, it is held by its key, not by the pedal.
-                self.unsustain(|n| n.channel == note.channel && n.key == note.key);
-                emit(NoteEvent::On {
-                    time,
-                    note,
-                    velocity,
-                });
-                let c = index(note.channel);
-                let mut express = |expression| {
-                    emit(NoteEvent::Expression {
-                        time,
-                        note,
-                        expression,
-                    })
-                };
-                // A member channel's bend and pressure, and a channel's slide, sent before the
-                // note, shape it from its first sample.
-                if is_member(note.channel) {
-                    let bend = self.channel_bend[c] * controls.mpe_bend_range_semitones;
-                    express(NoteExpression::Tuning(bend));
-                }
-                if channel_pressure_is_the_notes(note.channel) && pressure_is_the_notes {
-                    express(NoteExpression::Pressure(self.channel_pressure[c]));
-                }
-                if let Some(slide) = self.channel_slide[c] {
-                    express(NoteExpression::Slide(slide));
-                }
+                self.note_on(time, note, velocity, routing, emit)
             }
             MidiMessage::NoteOn { note, .. } | MidiMessage::NoteOff { note } => {
                 let held = self.pedal[index(note.channel)]
-                    || (mpe && self.pedal[MPE_MANAGER_CHANNEL as usize]);
+                    || (routing.mpe && self.pedal[MPE_MANAGER_CHANNEL as usize]);
                 if held && self.num_sustained < MAX_SUSTAINED {
                     self.sustained[self.num_sustained] = note;
                     self.num_sustained += 1;
@@ -196,7 +202,7 @@ impl MidiInput {
                 }
             }
             MidiMessage::PolyPressure { note, pressure } => {
-                if pressure_is_the_notes {
+                if routing.pressure_is_the_notes {
                     emit(NoteEvent::Expression {
                         time,
                         note,
@@ -205,77 +211,151 @@ impl MidiInput {
                 }
             }
             MidiMessage::PitchBend { channel, value } => {
-                let bend = bend_of(value);
-                if is_member(channel) {
-                    self.channel_bend[index(channel)] = bend;
-                    emit(NoteEvent::ChannelExpression {
-                        time,
-                        channel,
-                        expression: NoteExpression::Tuning(
-                            bend * controls.mpe_bend_range_semitones,
-                        ),
-                    });
-                } else {
-                    emit(NoteEvent::Controller {
-                        time,
-                        change: ControlChange::Bend(bend),
-                    });
-                }
+                self.pitch_bend(time, channel, value, routing, emit)
             }
             MidiMessage::ChannelPressure { channel, pressure } => {
-                let pressure = pressure.clamp(0.0, 1.0);
-                if channel_pressure_is_the_notes(channel) {
-                    self.channel_pressure[index(channel)] = pressure;
-                    if pressure_is_the_notes {
-                        emit(NoteEvent::ChannelExpression {
-                            time,
-                            channel,
-                            expression: NoteExpression::Pressure(pressure),
-                        });
-                    }
-                } else {
-                    emit(NoteEvent::Controller {
-                        time,
-                        change: ControlChange::Pressure(pressure),
-                    });
-                }
+                self.channel_pressure(time, channel, pressure, routing, emit)
             }
             MidiMessage::Control { channel, cc, value } => {
-                let value = value.clamp(0.0, 1.0);
-                match cc {
-                    SLIDE_CC => {
-                        self.channel_slide[index(channel)] = Some(value);
-                        emit(NoteEvent::ChannelExpression {
-                            time,
-                            channel,
-                            expression: NoteExpression::Slide(value),
-                        });
-                    }
-                    MOD_WHEEL_CC => emit(NoteEvent::Controller {
-                        time,
-                        change: ControlChange::ModWheel(value),
-                    }),
-                    SUSTAIN_CC => {
-                        self.pedal[index(channel)] = value >= 0.5;
-                        // Notes whose pedal has come up are let go.
-                        let manager = mpe && self.pedal[MPE_MANAGER_CHANNEL as usize];
-                        let pedal = self.pedal;
-                        self.unsustain_with(
-                            |n| !manager && !pedal[index(n.channel)],
-                            |note| emit(NoteEvent::Off { time, note }),
-                        );
-                    }
-                    ALL_SOUND_OFF_CC => {
-                        self.num_sustained = 0;
-                        emit(NoteEvent::AllSoundOff { time });
-                    }
-                    ALL_NOTES_OFF_CC => {
-                        self.num_sustained = 0;
-                        emit(NoteEvent::AllNotesOff { time });
-                    }
-                    _ => {}
-                }
+                self.control(time, channel, cc, value, routing, emit)
             }
+        }
+    }
+
+    /// A note struck: it starts with its channel's bend (a member channel's), pressure (when
+    /// its own) and slide, sent before it, so they shape it from its first sample.
+    fn note_on(
+        &mut self,
+        time: u32,
+        note: Note,
+        velocity: f32,
+        routing: Routing,
+        emit: &mut impl FnMut(NoteEvent),
+    ) {
+        // Pressed again, it is held by its key, not by the pedal.
+        self.unsustain(|n| n.channel == note.channel && n.key == note.key);
+        emit(NoteEvent::On {
+            time,
+            note,
+            velocity,
+        });
+        let c = index(note.channel);
+        let mut express = |expression| {
+            emit(NoteEvent::Expression {
+                time,
+                note,
+                expression,
+            })
+        };
+        if routing.is_member(note.channel) {
+            let bend = self.channel_bend[c] * routing.mpe_bend_range_semitones;
+            express(NoteExpression::Tuning(bend));
+        }
+        if routing.channel_pressure_is_the_notes(note.channel) && routing.pressure_is_the_notes {
+            express(NoteExpression::Pressure(self.channel_pressure[c]));
+        }
+        if let Some(slide) = self.channel_slide[c] {
+            express(NoteExpression::Slide(slide));
+        }
+    }
+
+    /// Pitch bend on `channel` (`value` on the wire, 0 to 1): a member channel's notes' own, or
+    /// the engine's.
+    fn pitch_bend(
+        &mut self,
+        time: u32,
+        channel: u8,
+        value: f32,
+        routing: Routing,
+        emit: &mut impl FnMut(NoteEvent),
+    ) {
+        let bend = bend_of(value);
+        if routing.is_member(channel) {
+            self.channel_bend[index(channel)] = bend;
+            emit(NoteEvent::ChannelExpression {
+                time,
+                channel,
+                expression: NoteExpression::Tuning(bend * routing.mpe_bend_range_semitones),
+            });
+        } else {
+            emit(NoteEvent::Controller {
+                time,
+                change: ControlChange::Bend(bend),
+            });
+        }
+    }
+
+    /// Channel pressure on `channel`: its notes' own, or the engine's.
+    fn channel_pressure(
+        &mut self,
+        time: u32,
+        channel: u8,
+        pressure: f32,
+        routing: Routing,
+        emit: &mut impl FnMut(NoteEvent),
+    ) {
+        let pressure = pressure.clamp(0.0, 1.0);
+        if routing.channel_pressure_is_the_notes(channel) {
+            self.channel_pressure[index(channel)] = pressure;
+            if routing.pressure_is_the_notes {
+                emit(NoteEvent::ChannelExpression {
+                    time,
+                    channel,
+                    expression: NoteExpression::Pressure(pressure),
+                });
+            }
+        } else {
+            emit(NoteEvent::Controller {
+                time,
+                change: ControlChange::Pressure(pressure),
+            });
+        }
+    }
+
+    /// Controller `cc` on `channel` moves to `value` (0 to 1): slide, mod wheel, sustain pedal,
+    /// all sound off, all notes off; others are ignored.
+    fn control(
+        &mut self,
+        time: u32,
+        channel: u8,
+        cc: u8,
+        value: f32,
+        routing: Routing,
+        emit: &mut impl FnMut(NoteEvent),
+    ) {
+        let value = value.clamp(0.0, 1.0);
+        match cc {
+            SLIDE_CC => {
+                self.channel_slide[index(channel)] = Some(value);
+                emit(NoteEvent::ChannelExpression {
+                    time,
+                    channel,
+                    expression: NoteExpression::Slide(value),
+                });
+            }
+            MOD_WHEEL_CC => emit(NoteEvent::Controller {
+                time,
+                change: ControlChange::ModWheel(value),
+            }),
+            SUSTAIN_CC => {
+                self.pedal[index(channel)] = value >= 0.5;
+                // Notes whose pedal has come up are let go.
+                let manager = routing.mpe && self.pedal[MPE_MANAGER_CHANNEL as usize];
+                let pedal = self.pedal;
+                self.unsustain_with(
+                    |n| !manager && !pedal[index(n.channel)],
+                    |note| emit(NoteEvent::Off { time, note }),
+                );
+            }
+            ALL_SOUND_OFF_CC => {
+                self.num_sustained = 0;
+                emit(NoteEvent::AllSoundOff { time });
+            }
+            ALL_NOTES_OFF_CC => {
+                self.num_sustained = 0;
+                emit(NoteEvent::AllNotesOff { time });
+            }
+            _ => {}
         }
     }
 

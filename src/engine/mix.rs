@@ -1,9 +1,10 @@
 //! What is mixed around an engine: its audio input taken to mono, strikes at the input's onsets,
-//! the fade of an outgoing engine after a bank swap, the dry/wet mix and the bypass fade. Each
-//! keeps its own state between blocks, so a change of setting ramps instead of clicking, and none
-//! allocates.
+//! the fade of an outgoing engine after a bank swap, and the output stage: the dry/wet mix, the
+//! bypass fade and the flush of subnormals. Each keeps its own state between blocks, so a change
+//! of setting ramps instead of clicking, and none allocates.
 
 use super::NoteEvent;
+use crate::dsp::denormal::flush_subnormals;
 use crate::dsp::onset::OnsetDetector;
 
 /// How long the engine playing before a bank swap fades out, in seconds.
@@ -182,6 +183,48 @@ impl Bypass {
     }
 }
 
+/// The last stage before the host: the dry/wet mix with the input, the host's bypass, and no
+/// subnormal sample out (a dry path copies what the host sends, and the plugins after this one
+/// may not flush).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct OutputStage {
+    /// The dry/wet mix, ramped from segment to segment.
+    dry_wet: DryWet,
+    /// The host's bypass, faded.
+    bypass: Bypass,
+}
+
+impl OutputStage {
+    /// Forgets the last settings: the next block starts at its own.
+    pub fn reset(&mut self) {
+        self.dry_wet.reset();
+        self.bypass.reset();
+    }
+
+    /// Finishes `out`, the engine's output: mixed with `input` (the effect's input, or the
+    /// instrument's exciter input, if any) at `wet`, then faded toward the input while
+    /// `bypassed` when `bypass_to_input` (an effect), else toward silence, at `sample_rate_hz`.
+    pub fn apply(
+        &mut self,
+        out: [&mut [f32]; 2],
+        input: Option<[&[f32]; 2]>,
+        wet: f32,
+        bypassed: bool,
+        bypass_to_input: bool,
+        sample_rate_hz: f32,
+    ) {
+        let [out_l, out_r] = out;
+        if let Some(dry) = input {
+            self.dry_wet.mix([&mut *out_l, &mut *out_r], dry, wet);
+        }
+        let dry = input.filter(|_| bypass_to_input);
+        self.bypass
+            .apply([&mut *out_l, &mut *out_r], dry, bypassed, sample_rate_hz);
+        flush_subnormals(out_l);
+        flush_subnormals(out_r);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -267,6 +310,16 @@ mod tests {
             bypass.apply([&mut l, &mut r], dry_pair, false, RATE);
             assert!((l[0] - target).abs() < 0.01 && l[fade + 1] == 1.0);
         }
+    }
+
+    #[test]
+    fn the_output_stage_lets_no_subnormal_out() {
+        let mut stage = OutputStage::default();
+        let tiny = f32::MIN_POSITIVE / 4.0;
+        let (mut l, mut r) = (vec![tiny; 64], vec![-tiny; 64]);
+        let dry = vec![tiny; 64];
+        stage.apply([&mut l, &mut r], Some([&dry, &dry]), 0.5, false, true, RATE);
+        assert!(l.iter().chain(&r).all(|&v| v == 0.0), "{l:?} {r:?}");
     }
 
     #[test]

@@ -10,7 +10,7 @@ use super::stereo::{balanced_pans, lane_weights, COLUMN_PAN};
 use crate::bank::format::MIN_DECAY_PER_S;
 use crate::bank::Bank;
 use crate::dsp::coeffs::ModeCoeffs;
-use crate::dsp::{Exciter, ExciterKind, Kernel, ResonatorBank, COLUMNS};
+use crate::dsp::{Exciter, Kernel, ResonatorBank, StrikeKind, COLUMNS};
 use crate::units::hz_to_midi_key;
 
 /// Peak of a full-velocity strike with the bank's default controls (its default strike
@@ -204,7 +204,7 @@ impl PreparedBank {
     /// still ringing at its end.
     ///
     /// `kind` replaces the bank's default exciter when given.
-    fn render_default_strike(&self, kind: Option<ExciterKind>) -> (Vec<[f32; COLUMNS]>, Ringing) {
+    fn render_default_strike(&self, kind: Option<StrikeKind>) -> (Vec<[f32; COLUMNS]>, Ringing) {
         let controls = Controls::for_bank(&self.source);
         let n = self.num_modes();
         let mut bank = ResonatorBank::new(n);
@@ -227,11 +227,7 @@ impl PreparedBank {
         let contact = (controls.hardness_ms as f64 * 1e-3 * MEASURE_RATE_HZ).round() as u32;
         // A bank played by a contact is set to the level of a mallet strike, which a contact at
         // its defaults matches.
-        let kind = kind.unwrap_or(if controls.exciter.is_contact() {
-            ExciterKind::Mallet
-        } else {
-            controls.exciter
-        });
+        let kind = kind.unwrap_or(controls.exciter.knock());
         exciter.strike(kind, 1.0, contact);
         // Long enough for the slowest beating of the lowest modes to build up.
         let lowest = self.freq_hz.first().copied().unwrap_or(100.0).max(1.0);
@@ -262,10 +258,10 @@ impl PreparedBank {
     /// peak is measured the same way, and [`PitchLevel`] goes between them.
     fn measure_pitch_level(&self, root_peak: f32) -> PitchLevel {
         let controls = Controls::for_bank(&self.source);
-        if !(controls.exciter == ExciterKind::Mallet || controls.exciter.is_contact()) {
+        if controls.exciter.knock() != StrikeKind::Mallet {
             return PitchLevel::default();
         }
-        let (frames, mut ringing) = self.render_default_strike(Some(ExciterKind::Impulse));
+        let (frames, mut ringing) = self.render_default_strike(Some(StrikeKind::Impulse));
         let impulse_peak = self.default_peak(&frames, &mut ringing);
         let w = self.positions.weights(controls.strike_x, controls.strike_y);
         let gains: Vec<f32> = (0..self.num_modes()).map(|m| self.gain_at(m, &w)).collect();

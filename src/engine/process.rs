@@ -1,7 +1,7 @@
 //! The audio-thread half of the engine: events, control ticks and rendering.
 
 use super::*;
-use crate::dsp::contact::ContactKind;
+use crate::dsp::contact::{ContactKind, ContactMotion};
 use crate::dsp::masking::DB_PER_NEPER;
 use crate::dsp::ExciterKind;
 
@@ -124,31 +124,49 @@ impl Engine {
 
     /// Smoothing steps, truncation, freeing and coefficient updates, every `CONTROL_PERIOD`.
     fn control_tick(&mut self) {
-        let silent = self.is_silent();
-        if silent {
+        self.smooth_damping();
+        self.ramp_width();
+        let input_heard = std::mem::take(&mut self.input_heard);
+        self.tick_voices(input_heard);
+        // Polyphony lowered: fade the quietest voices beyond the limit.
+        let polyphony = self.expressed.polyphony.min(self.capacity);
+        while self.voices.iter().filter(|v| v.is_sounding()).count() > polyphony {
+            let victim = self.quietest_sounding();
+            self.voices[victim].state = VoiceState::Fading;
+        }
+        self.prune_tick(input_heard);
+    }
+
+    /// Steps the damping and its tilt towards their targets (jumps, when nothing sounds), and
+    /// brings the decay table up to date for the voices sounding.
+    fn smooth_damping(&mut self) {
+        if self.is_silent() {
             // Nothing sounds, so nothing can zipper: jump to the targets.
             self.snap_smoothing();
-        } else {
-            let (target_damping, target_tilt) = self.damping_targets();
-            let k = self.tick_coefficient(DAMPING_SMOOTHING_S);
-            let s = &mut self.smoothed;
-            if s.log_damping != target_damping || s.tilt != target_tilt {
-                let tilt_moved = s.tilt != target_tilt;
-                s.log_damping = step_towards(s.log_damping, target_damping, k, 1e-4);
-                s.tilt = step_towards(s.tilt, target_tilt, k, 1e-4);
-                let stale = if tilt_moved {
-                    Stale::Tilt
-                } else {
-                    Stale::Damping
-                };
-                self.decay_stale = self.decay_stale.max(stale);
-            }
-            // Only sounding voices need the table now; a note-on brings it up to date otherwise.
-            if self.decay_stale != Stale::Fresh {
-                self.rebuild_decay_table();
-            }
+            return;
         }
-        // Stereo width: ramp the column weights over the next period.
+        let (target_damping, target_tilt) = self.damping_targets();
+        let k = self.tick_coefficient(DAMPING_SMOOTHING_S);
+        let s = &mut self.smoothed;
+        if s.log_damping != target_damping || s.tilt != target_tilt {
+            let tilt_moved = s.tilt != target_tilt;
+            s.log_damping = step_towards(s.log_damping, target_damping, k, 1e-4);
+            s.tilt = step_towards(s.tilt, target_tilt, k, 1e-4);
+            let stale = if tilt_moved {
+                Stale::Tilt
+            } else {
+                Stale::Damping
+            };
+            self.decay_stale = self.decay_stale.max(stale);
+        }
+        // Only sounding voices need the table now; a note-on brings it up to date otherwise.
+        if self.decay_stale != Stale::Fresh {
+            self.rebuild_decay_table();
+        }
+    }
+
+    /// Stereo width: ramps the column weights over the next period to the width's.
+    fn ramp_width(&mut self) {
         let target = lane_weights(self.expressed.width, &self.bank.column_pan);
         if target != self.smoothed.weights && self.smoothed.weight_ramp_left == 0 {
             let inv = 1.0 / CONTROL_PERIOD as f32;
@@ -159,13 +177,17 @@ impl Engine {
             self.smoothed.weight_target = target;
             self.smoothed.weight_ramp_left = CONTROL_PERIOD;
         }
+    }
 
+    /// Each sounding voice (and the input voice, heard this period if `input_heard`): fades
+    /// finished, modes under the truncation threshold retired (the voice ended when none is
+    /// left), its contact following its targets, its pitch stepped and its modes retuned.
+    fn tick_voices(&mut self, input_heard: bool) {
         let threshold = db_to_gain(self.expressed.truncation_db);
         let pitch_k = self.tick_coefficient(PITCH_SMOOTHING_S);
         let input_key = self
             .last_key
             .unwrap_or(self.bank.root_key.round().clamp(0.0, 127.0) as u8);
-        let input_heard = std::mem::take(&mut self.input_heard);
         let release = self.release_decay();
         let version = self.damping_version;
         let num_voices = self.voices.len();
@@ -222,13 +244,6 @@ impl Engine {
                 v.retune(bank, decay, rate, tuning);
             }
         }
-        // Polyphony lowered: fade the quietest voices beyond the limit.
-        let polyphony = self.expressed.polyphony.min(self.capacity);
-        while self.voices.iter().filter(|v| v.is_sounding()).count() > polyphony {
-            let victim = self.quietest_sounding();
-            self.voices[victim].state = VoiceState::Fading;
-        }
-        self.prune_tick(input_heard);
     }
 
     fn apply_event(&mut self, event: NoteEvent) {
@@ -394,7 +409,7 @@ impl Engine {
         v.tuning_semitones = 0.0;
         v.pressure = 0.0;
         v.pressed = false;
-        v.slide = None;
+        v.speed_m_per_s = None;
         v.overrides = VoiceOverrides::default();
         v.state = VoiceState::Held;
         v.pending_strike = Some(PendingStrike { velocity, fresh });
@@ -487,20 +502,20 @@ impl Engine {
         if start_dormant || self.voices[i].modes.num_dormant() > 0 {
             self.settle_strike(i, kind, amplitude, len);
         }
-        if kind.is_contact() {
-            self.start_contact(i, kind, amplitude, hardness_ms);
+        if let Some(motion) = kind.contact() {
+            self.start_contact(i, motion, amplitude, hardness_ms);
         }
     }
 
-    /// Starts voice `i`'s contact of `kind` (a scrape, roll or rub) at velocity-derived force
-    /// `amplitude`, its width from `hardness_ms`. A note released at the sample it started
-    /// (a click on the strike pad, a note of no length) lets go of it at once.
-    fn start_contact(&mut self, i: usize, kind: ExciterKind, amplitude: f32, hardness_ms: f32) {
+    /// Starts voice `i`'s contact moving as `motion` at velocity-derived force `amplitude`, its
+    /// width from `hardness_ms`. A note released at the sample it started (a click on the
+    /// strike pad, a note of no length) lets go of it at once.
+    fn start_contact(&mut self, i: usize, motion: ContactMotion, amplitude: f32, hardness_ms: f32) {
         let c = &self.expressed;
         let v = &mut self.voices[i];
         v.contact_velocity = amplitude;
         let (speed, force) = contact_targets(c, v);
-        let shape = contact_shape(c, kind, hardness_ms);
+        let shape = contact_shape(c, motion, hardness_ms);
         v.exciter
             .start_contact(shape, c.roughness, self.sample_rate_hz, speed, force);
         if v.state != VoiceState::Held {
@@ -723,29 +738,28 @@ fn vary_gains(variation: f32, rng: &mut Rng, gains: &mut [f32]) {
 /// a quarter of a millimetre (a corner at 2 kHz at 0.5 m/s), a soft 5 ms through 5 mm.
 const SCRAPE_WIDTH_M_PER_MS: f64 = 1e-3;
 
-/// The contact a note of exciter `kind` (a contact) plays, at hardness `hardness_ms`.
-fn contact_shape(c: &Controls, kind: ExciterKind, hardness_ms: f32) -> ContactKind {
-    match kind {
-        ExciterKind::Roll => ContactKind::Roll {
-            radius_m: c.rolling_radius_mm as f64 * 1e-3,
-        },
-        ExciterKind::Rub => ContactKind::Rub,
-        _ => ContactKind::Scrape {
+/// The contact a note held with `motion` plays, at hardness `hardness_ms`.
+fn contact_shape(c: &Controls, motion: ContactMotion, hardness_ms: f32) -> ContactKind {
+    match motion {
+        ContactMotion::Scrape => ContactKind::Scrape {
             width_m: hardness_ms as f64 * SCRAPE_WIDTH_M_PER_MS,
         },
+        ContactMotion::Roll => ContactKind::Roll {
+            radius_m: c.rolling_radius_mm as f64 * 1e-3,
+        },
+        ContactMotion::Rub => ContactKind::Rub,
     }
 }
 
-/// Where a contact note's speed (m/s) and force are going: the note's slide, else its own
-/// contact speed (polyphonic modulation), else the contact speed; the note's own pressure once it
+/// Where a contact note's speed (m/s) and force are going: the note's own speed (its slide),
+/// else its own contact speed (polyphonic modulation), else the contact speed; the note's own pressure once it
 /// has pressed, else its own or the engine's contact force (which the channel's pressure or mod
 /// wheel may set) times its velocity.
 fn contact_targets(c: &Controls, v: &Voice) -> (f32, f32) {
     let o = &v.overrides;
-    let speed = v.slide.map_or(
-        o.contact_speed_m_per_s.unwrap_or(c.contact_speed_m_per_s),
-        |s| s * CONTACT_SPEED_MAX_M_PER_S,
-    );
+    let speed = v
+        .speed_m_per_s
+        .unwrap_or(o.contact_speed_m_per_s.unwrap_or(c.contact_speed_m_per_s));
     let force = if v.pressed {
         v.pressure
     } else {

@@ -37,23 +37,14 @@ mod maskers;
 mod off_reason;
 mod strike;
 
+use super::mode_fade::fade_samples;
 use super::voice::{Tuning, Voice, VoiceState};
 use super::{Engine, CONTROL_PERIOD};
 use crate::dsp::pruning::MaskingPass;
-use crate::dsp::resonator_bank::{floor, DormantMode};
+use crate::dsp::resonator_bank::DormantMode;
 use candidates::Candidates;
 use maskers::Maskers;
 use off_reason::OffReason;
-
-/// Shortest fade in or out, in seconds: short enough to follow the masking.
-const FADE_S: f64 = 0.005;
-
-/// Fades last at least this many periods of the mode, so low modes fade smoothly too (a 40 Hz
-/// mode over 50 ms).
-const FADE_PERIODS: f64 = 2.0;
-
-/// Longest fade, in seconds.
-const MAX_FADE_S: f64 = 0.25;
 
 /// Every this many analyses, every mode is looked at, so a strike that masks other voices' modes
 /// switches them off.
@@ -338,19 +329,6 @@ impl Pruner {
 fn frame_samples(frame_ms: f32, sample_rate_hz: f64) -> u64 {
     let periods = (frame_ms as f64 * 1e-3 * sample_rate_hz / CONTROL_PERIOD as f64).round();
     periods.max(1.0) as u64 * CONTROL_PERIOD as u64
-}
-
-/// Samples of a fade for a mode at `theta` radians per sample: [`FADE_S`] or [`FADE_PERIODS`] of
-/// the mode, whichever is longer (at most [`MAX_FADE_S`]), rounded up to whole control periods so
-/// fades started on a tick end on one.
-pub(in crate::engine) fn fade_samples(theta: f32, sample_rate_hz: f64) -> u32 {
-    let periods = FADE_PERIODS * std::f64::consts::TAU / (theta as f64).max(1e-9);
-    let samples = (FADE_S * sample_rate_hz)
-        .max(periods)
-        .min(MAX_FADE_S * sample_rate_hz);
-    // Rounded up without `f64::ceil`, a library call on x86-64 without SSE4.1.
-    let blocks = -floor(-samples / CONTROL_PERIOD as f64);
-    blocks.max(1.0) as u32 * CONTROL_PERIOD as u32
 }
 
 /// Samples (as a clock offset) a level `margin_db` above a line can fall at `fall_db` per sample

@@ -2,9 +2,9 @@
 
 use std::f64::consts::TAU;
 
+use super::mode_fade::fade_samples;
 use super::prepared::PreparedBank;
-use super::pruning::fade_samples;
-use super::{NoteExpression, VoiceModulation, MAX_EXPRESSION_SEMITONES};
+use super::{NoteExpression, VoiceModulation, CONTACT_SPEED_MAX_M_PER_S, MAX_EXPRESSION_SEMITONES};
 use crate::bank::format::MAX_FREQ_RATIO;
 use crate::dsp::coeffs::ModeCoeffs;
 use crate::dsp::{Exciter, ExciterKind, ResonatorBank};
@@ -119,8 +119,9 @@ pub struct Voice {
     /// Whether the note's pressure has been above 0 since it started: it then sets a contact's
     /// force.
     pub pressed: bool,
-    /// Per-note slide 0 to 1 (note expression, MPE's CC 74): a contact's speed, if it came.
-    pub slide: Option<f32>,
+    /// The note's own contact speed in m/s, from its slide (note expression, MPE's CC 74) or a
+    /// rendered note's speed curve, if one came.
+    pub speed_m_per_s: Option<f32>,
 }
 
 impl Voice {
@@ -146,7 +147,7 @@ impl Voice {
             contact: false,
             contact_velocity: 0.0,
             pressed: false,
-            slide: None,
+            speed_m_per_s: None,
         }
     }
 
@@ -168,7 +169,7 @@ impl Voice {
         self.pressure = 0.0;
         self.contact = false;
         self.pressed = false;
-        self.slide = None;
+        self.speed_m_per_s = None;
         self.id = None;
         self.overrides = VoiceOverrides::default();
         self.pending_strike = None;
@@ -187,7 +188,11 @@ impl Voice {
                 // sends the channel's resting pressure, 0, with each note).
                 self.pressed |= self.pressure > 0.0;
             }
-            NoteExpression::Slide(s) if s.is_finite() => self.slide = Some(s.clamp(0.0, 1.0)),
+            NoteExpression::Slide(s) if s.is_finite() => {
+                self.speed_m_per_s = Some(s.clamp(0.0, 1.0) * CONTACT_SPEED_MAX_M_PER_S)
+            }
+            // Sanitised where the contact takes it ([`crate::dsp::contact::Contact::set_targets`]).
+            NoteExpression::ContactSpeed(v) => self.speed_m_per_s = Some(v),
             _ => {}
         }
     }
@@ -256,7 +261,8 @@ impl Voice {
         start_dormant: bool,
     ) {
         let pitch = tuning.log_pitch.exp();
-        let bound = amplitude * kind.peak_bound(len_samples);
+        let knock = kind.knock();
+        let bound = amplitude * knock.peak_bound(len_samples);
         let threshold = start_threshold(threshold, bank.num_modes());
         let heard = |gain: f32| gain.abs() * bound >= threshold;
         // A strike point reaches some of a bank's modes only (one object of a scene): runs of
@@ -278,7 +284,7 @@ impl Voice {
         // A contact is started by the engine, which knows its controls. A key struck again while
         // its contact goes on knocks the object (a mallet strike), and the contact goes on.
         if !kind.is_contact() || self.exciter.holds_contact() {
-            self.exciter.strike(kind, amplitude, len_samples);
+            self.exciter.strike(knock, amplitude, len_samples);
         }
     }
 

@@ -5,7 +5,7 @@
 use crossbeam_channel::{Receiver, Sender};
 
 use super::bank_loader::LoadedEngine;
-use crate::engine::{Engine, FadeOut, Note, MAX_POLYPHONY};
+use crate::engine::{BankCrossfade, Engine, Note, MAX_POLYPHONY};
 
 /// Engines handed to the background thread at once, before one waits for room.
 const TRASH_CAPACITY: usize = 8;
@@ -28,20 +28,12 @@ pub struct BackgroundEnds {
     pub trash_rx: Receiver<Box<Engine>>,
 }
 
-/// The engine that was playing before a bank swap, fading out.
-pub struct Outgoing {
-    /// The engine.
-    pub engine: Box<Engine>,
-    /// Its fade to silence.
-    pub fade: FadeOut,
-}
-
 /// The audio thread's engines.
 pub struct Engines {
     /// The engine playing; `None` until activated.
     pub current: Option<Box<Engine>>,
     /// The engine that played before the last swap, while it fades out.
-    pub outgoing: Option<Outgoing>,
+    pub outgoing: BankCrossfade,
     /// Engines built by the background thread.
     loaded_rx: Receiver<LoadedEngine>,
     /// Engines to drop, for the background thread.
@@ -61,13 +53,14 @@ pub struct Engines {
 }
 
 impl Engines {
-    /// No engines yet, and the channels to the background thread.
-    pub fn new() -> (Self, BackgroundEnds) {
+    /// No engines yet, and the channels to the background thread; the outgoing engine takes up
+    /// to `max_events` events per segment.
+    pub fn new(max_events: usize) -> (Self, BackgroundEnds) {
         let (loaded_tx, loaded_rx) = crossbeam_channel::bounded(LOADED_CAPACITY);
         let (trash_tx, trash_rx) = crossbeam_channel::bounded(TRASH_CAPACITY);
         let engines = Self {
             current: None,
-            outgoing: None,
+            outgoing: BankCrossfade::new(max_events),
             loaded_rx,
             trash_tx,
             waiting: Default::default(),
@@ -90,7 +83,7 @@ impl Engines {
     /// anything built for an earlier activation is ignored.
     pub fn activate(&mut self, engine: Box<Engine>, generation: u64) {
         self.current = Some(engine);
-        self.outgoing = None;
+        drop(self.outgoing.take());
         self.epoch += 1;
         self.requested_generation = generation;
         self.playing_generation = generation;
@@ -167,11 +160,7 @@ impl Engines {
                     Some(old) if !old.is_silent() => {
                         old.notes().for_each(&mut ended);
                         // A fade already under way is cut short by the newer swap.
-                        let cut = self.outgoing.replace(Outgoing {
-                            engine: old,
-                            fade: FadeOut::new(),
-                        });
-                        cut.map(|o| o.engine)
+                        self.outgoing.start(old)
                     }
                     old => old,
                 }
@@ -188,7 +177,7 @@ impl Engines {
     /// Ends the outgoing engine's fade at once (on a reset).
     pub fn drop_outgoing(&mut self) -> bool {
         match self.outgoing.take() {
-            Some(o) => self.discard(o.engine),
+            Some(engine) => self.discard(engine),
             None => false,
         }
     }
@@ -261,7 +250,7 @@ mod tests {
 
     #[test]
     fn the_bank_playing_is_asked_for_again_when_the_polyphony_outgrows_its_voices() {
-        let (mut engines, _background) = Engines::new();
+        let (mut engines, _background) = Engines::new(16);
         engines.activate(engine(20_000, 2), 1);
         let capacity = engines.current.as_ref().unwrap().voice_capacity();
         assert!(capacity < MAX_POLYPHONY, "{capacity}");
@@ -282,7 +271,7 @@ mod tests {
         assert_eq!(repeats.collect::<Vec<_>>(), [2]);
 
         // A small bank has every voice: no polyphony needs a rebuild.
-        let (mut engines, _background) = Engines::new();
+        let (mut engines, _background) = Engines::new(16);
         engines.activate(engine(100, 2), 1);
         for polyphony in [1, 16, MAX_POLYPHONY, 1_000] {
             assert_eq!(engines.request(1, 0, polyphony), None, "{polyphony}");

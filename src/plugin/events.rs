@@ -53,152 +53,7 @@ impl<K: Kind> ModalPlugin<K> {
         self.block_controls = self.params.controls();
         self.read_auditions();
         while let Some(event) = context.next_event() {
-            let midi = match event {
-                NoteEvent::NoteOn {
-                    timing,
-                    voice_id,
-                    channel,
-                    key,
-                    velocity,
-                } => {
-                    let Some(note) = note_of(voice_id, channel, key).filter(|n| n.key != NO_KEY)
-                    else {
-                        continue;
-                    };
-                    if velocity > 0.0 {
-                        self.last_key = Some(note.key);
-                    }
-                    Some((timing, MidiMessage::NoteOn { note, velocity }))
-                }
-                // A wildcard key (and no id) means every note.
-                NoteEvent::NoteOff {
-                    timing,
-                    voice_id,
-                    channel,
-                    key,
-                    ..
-                } => match note_of(voice_id, channel, key) {
-                    Some(note) => Some((timing, MidiMessage::NoteOff { note })),
-                    None => {
-                        self.push(EngineEvent::AllNotesOff { time: timing });
-                        None
-                    }
-                },
-                NoteEvent::PolyPressure {
-                    timing,
-                    voice_id,
-                    channel,
-                    key,
-                    pressure,
-                } => note_of(voice_id, channel, key)
-                    .map(|note| (timing, MidiMessage::PolyPressure { note, pressure })),
-                NoteEvent::MidiPitchBend {
-                    timing,
-                    channel,
-                    value,
-                } => Some((timing, MidiMessage::PitchBend { channel, value })),
-                NoteEvent::MidiChannelPressure {
-                    timing,
-                    channel,
-                    pressure,
-                } => Some((timing, MidiMessage::ChannelPressure { channel, pressure })),
-                NoteEvent::MidiCC {
-                    timing,
-                    cc,
-                    channel,
-                    value,
-                } => Some((timing, MidiMessage::Control { channel, cc, value })),
-                NoteEvent::Choke {
-                    timing,
-                    voice_id,
-                    channel,
-                    key,
-                } => {
-                    self.push(match note_of(voice_id, channel, key) {
-                        Some(note) => EngineEvent::Choke { time: timing, note },
-                        None => EngineEvent::AllSoundOff { time: timing },
-                    });
-                    None
-                }
-                NoteEvent::PolyTuning {
-                    timing,
-                    voice_id,
-                    channel,
-                    key,
-                    tuning,
-                } => {
-                    if let Some(note) = note_of(voice_id, channel, key) {
-                        self.push(EngineEvent::Expression {
-                            time: timing,
-                            note,
-                            expression: NoteExpression::Tuning(tuning),
-                        });
-                    }
-                    None
-                }
-                // Brightness (CLAP's note expression) is a note's slide: a contact's speed.
-                NoteEvent::PolyBrightness {
-                    timing,
-                    voice_id,
-                    channel,
-                    key,
-                    brightness,
-                } => {
-                    if let Some(note) = note_of(voice_id, channel, key) {
-                        self.push(EngineEvent::Expression {
-                            time: timing,
-                            note,
-                            expression: NoteExpression::Slide(brightness),
-                        });
-                    }
-                    None
-                }
-                NoteEvent::PolyModulation {
-                    timing,
-                    voice_id,
-                    poly_modulation_id,
-                    normalized_offset,
-                } => {
-                    self.poly
-                        .set(voice_id, poly_modulation_id, normalized_offset);
-                    let base = self.params.poly_base(poly_modulation_id).unwrap_or(0.0);
-                    if let Some(modulation) = self
-                        .params
-                        .voice_modulation(poly_modulation_id, base + normalized_offset)
-                    {
-                        self.push(EngineEvent::Modulate {
-                            time: timing,
-                            id: voice_id,
-                            modulation,
-                        });
-                    }
-                    None
-                }
-                NoteEvent::MonoAutomation {
-                    timing,
-                    poly_modulation_id,
-                    normalized_value,
-                } => {
-                    // Every modulated note moves with the parameter's new value.
-                    for (id, offset) in self.poly.offsets(poly_modulation_id) {
-                        if let Some(modulation) = self
-                            .params
-                            .voice_modulation(poly_modulation_id, normalized_value + offset)
-                        {
-                            if self.events.len() < MAX_EVENTS {
-                                self.events.push(EngineEvent::Modulate {
-                                    time: timing,
-                                    id,
-                                    modulation,
-                                });
-                            }
-                        }
-                    }
-                    None
-                }
-                _ => None,
-            };
-            if let Some((time, message)) = midi {
+            if let Some((time, message)) = self.midi_of(event) {
                 let events = &mut self.events;
                 self.midi
                     .read(time, message, &self.block_controls, |event| {
@@ -206,6 +61,166 @@ impl<K: Kind> ModalPlugin<K> {
                             events.push(event);
                         }
                     });
+            }
+        }
+    }
+
+    /// A host event as a MIDI message at its time, for the engine's MIDI reading; `None` for
+    /// the events read directly ([`ModalPlugin::read_direct`]) and for a note-off of every note.
+    fn midi_of(&mut self, event: PluginNoteEvent<Self>) -> Option<(u32, MidiMessage)> {
+        match event {
+            NoteEvent::NoteOn {
+                timing,
+                voice_id,
+                channel,
+                key,
+                velocity,
+            } => {
+                let note = note_of(voice_id, channel, key).filter(|n| n.key != NO_KEY)?;
+                if velocity > 0.0 {
+                    self.last_key = Some(note.key);
+                }
+                Some((timing, MidiMessage::NoteOn { note, velocity }))
+            }
+            // A wildcard key (and no id) means every note.
+            NoteEvent::NoteOff {
+                timing,
+                voice_id,
+                channel,
+                key,
+                ..
+            } => match note_of(voice_id, channel, key) {
+                Some(note) => Some((timing, MidiMessage::NoteOff { note })),
+                None => {
+                    self.push(EngineEvent::AllNotesOff { time: timing });
+                    None
+                }
+            },
+            NoteEvent::PolyPressure {
+                timing,
+                voice_id,
+                channel,
+                key,
+                pressure,
+            } => note_of(voice_id, channel, key)
+                .map(|note| (timing, MidiMessage::PolyPressure { note, pressure })),
+            NoteEvent::MidiPitchBend {
+                timing,
+                channel,
+                value,
+            } => Some((timing, MidiMessage::PitchBend { channel, value })),
+            NoteEvent::MidiChannelPressure {
+                timing,
+                channel,
+                pressure,
+            } => Some((timing, MidiMessage::ChannelPressure { channel, pressure })),
+            NoteEvent::MidiCC {
+                timing,
+                cc,
+                channel,
+                value,
+            } => Some((timing, MidiMessage::Control { channel, cc, value })),
+            event => {
+                self.read_direct(event);
+                None
+            }
+        }
+    }
+
+    /// Reads a host event that is no MIDI into `self.events`: a choke, a note expression, or
+    /// polyphonic modulation and the automation under it. Others are ignored.
+    fn read_direct(&mut self, event: PluginNoteEvent<Self>) {
+        match event {
+            NoteEvent::Choke {
+                timing,
+                voice_id,
+                channel,
+                key,
+            } => self.push(match note_of(voice_id, channel, key) {
+                Some(note) => EngineEvent::Choke { time: timing, note },
+                None => EngineEvent::AllSoundOff { time: timing },
+            }),
+            NoteEvent::PolyTuning {
+                timing,
+                voice_id,
+                channel,
+                key,
+                tuning,
+            } => self.express(
+                timing,
+                note_of(voice_id, channel, key),
+                NoteExpression::Tuning(tuning),
+            ),
+            // Brightness (CLAP's note expression) is a note's slide: a contact's speed.
+            NoteEvent::PolyBrightness {
+                timing,
+                voice_id,
+                channel,
+                key,
+                brightness,
+            } => self.express(
+                timing,
+                note_of(voice_id, channel, key),
+                NoteExpression::Slide(brightness),
+            ),
+            NoteEvent::PolyModulation {
+                timing,
+                voice_id,
+                poly_modulation_id,
+                normalized_offset,
+            } => self.modulate(timing, voice_id, poly_modulation_id, normalized_offset),
+            NoteEvent::MonoAutomation {
+                timing,
+                poly_modulation_id,
+                normalized_value,
+            } => self.automate_modulated(timing, poly_modulation_id, normalized_value),
+            _ => {}
+        }
+    }
+
+    /// Queues `expression` of `note` (if any) at `time`.
+    fn express(&mut self, time: u32, note: Option<Note>, expression: NoteExpression) {
+        if let Some(note) = note {
+            self.push(EngineEvent::Expression {
+                time,
+                note,
+                expression,
+            });
+        }
+    }
+
+    /// The host's polyphonic modulation of parameter `poly_id` on the note it knows as `id`, by
+    /// `normalized_offset` from the parameter's value: kept, and queued for the note.
+    fn modulate(&mut self, time: u32, id: i32, poly_id: u32, normalized_offset: f32) {
+        self.poly.set(id, poly_id, normalized_offset);
+        let base = self.params.poly_base(poly_id).unwrap_or(0.0);
+        if let Some(modulation) = self
+            .params
+            .voice_modulation(poly_id, base + normalized_offset)
+        {
+            self.push(EngineEvent::Modulate {
+                time,
+                id,
+                modulation,
+            });
+        }
+    }
+
+    /// Parameter `poly_id` moves to `normalized_value` (monophonic automation): every note it
+    /// modulates moves with it, keeping its offset.
+    fn automate_modulated(&mut self, time: u32, poly_id: u32, normalized_value: f32) {
+        for (id, offset) in self.poly.offsets(poly_id) {
+            if let Some(modulation) = self
+                .params
+                .voice_modulation(poly_id, normalized_value + offset)
+            {
+                if self.events.len() < MAX_EVENTS {
+                    self.events.push(EngineEvent::Modulate {
+                        time,
+                        id,
+                        modulation,
+                    });
+                }
             }
         }
     }

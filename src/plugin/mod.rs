@@ -22,11 +22,10 @@ pub use events::VST3_MIDI_CONTROLLERS;
 pub use kind::{Effect, Instrument, Kind};
 
 use crate::bank::factory::bank_from_state;
-use crate::dsp::denormal::flush_subnormals;
 use crate::editor::{self, EditorApp, EditorLinks, EditorShared, AUDITION_NOTE_ID};
 use crate::engine::{
-    mix_to_mono, Bypass, Controls, DryWet, EndedVoice, MidiInput, NoteEvent as EngineEvent,
-    OnsetTrigger, PositionMap, MAX_POLYPHONY,
+    mix_to_mono, Controls, EndedVoice, MidiInput, NoteEvent as EngineEvent, OnsetTrigger,
+    OutputStage, PositionMap, MAX_POLYPHONY,
 };
 use crate::params::{InputMode, ModalParams, STATE_FORMAT, STATE_FORMAT_FIELD};
 use engines::Engines;
@@ -98,13 +97,8 @@ pub struct ModalPlugin<K: Kind> {
     events: Vec<EngineEvent>,
     /// Note events of the part of the block being rendered, timed from its start.
     segment_events: Vec<EngineEvent>,
-    /// The channel-wide controller events of the part of the block being rendered, for the
-    /// outgoing engine.
-    outgoing_events: Vec<EngineEvent>,
     /// The host's polyphonic modulation offsets, per note id.
     poly: PolyTable,
-    /// Output of the outgoing engine.
-    outgoing_out: [Vec<f32>; 2],
     /// Mono mix of the audio input.
     input: Vec<f32>,
     /// Dry input (the effect's input, or the instrument's exciter input).
@@ -117,10 +111,8 @@ pub struct ModalPlugin<K: Kind> {
     block_controls: Controls,
     /// Last key struck, if any: the pitch of onsets (else the bank's root).
     last_key: Option<u8>,
-    /// The dry/wet mix, ramped from segment to segment.
-    dry_wet: DryWet,
-    /// The host's bypass, faded.
-    bypass: Bypass,
+    /// The dry/wet mix, the bypass and the flush of subnormals.
+    output: OutputStage,
     /// The editor's size and whether it is open.
     editor_state: Arc<EguiEditorState>,
     /// Meters for the editor and its strike pad's requests.
@@ -132,7 +124,7 @@ pub struct ModalPlugin<K: Kind> {
 
 impl<K: Kind> Default for ModalPlugin<K> {
     fn default() -> Self {
-        let (engines, background) = Engines::new();
+        let (engines, background) = Engines::new(MAX_EVENTS);
         Self {
             params: Arc::new(ModalParams::new(K::IS_EFFECT)),
             engines,
@@ -140,17 +132,14 @@ impl<K: Kind> Default for ModalPlugin<K> {
             background,
             events: Vec::with_capacity(MAX_EVENTS),
             segment_events: Vec::with_capacity(MAX_EVENTS),
-            outgoing_events: Vec::with_capacity(MAX_EVENTS),
             poly: PolyTable::new(POLY_NOTES),
-            outgoing_out: [Vec::new(), Vec::new()],
             input: Vec::new(),
             dry: [Vec::new(), Vec::new()],
             onsets: OnsetTrigger::new(48_000.0),
             midi: MidiInput::default(),
             block_controls: Controls::default(),
             last_key: None,
-            dry_wet: DryWet::default(),
-            bypass: Bypass::default(),
+            output: OutputStage::default(),
             editor_state: editor::default_state(),
             editor_shared: Arc::new(EditorShared::new()),
             audition_key: None,
@@ -241,44 +230,21 @@ impl<K: Kind> ModalPlugin<K> {
             report_ended(&mut self.poly, context, EndedVoice { time, ..ended });
         }
 
-        if let Some(outgoing) = self.engines.outgoing.as_mut() {
-            let [ol, or] = &mut self.outgoing_out;
-            let (ol, or) = (&mut ol[..n], &mut or[..n]);
-            outgoing.engine.set_controls(&controls);
-            self.outgoing_events.clear();
-            self.outgoing_events.extend(
-                self.segment_events
-                    .iter()
-                    .filter(|e| matches!(e, EngineEvent::Controller { .. })),
-            );
-            outgoing
-                .engine
-                .process(&self.outgoing_events, drive, ol, or);
-            let rate = outgoing.engine.sample_rate_hz();
-            outgoing.fade.add([out_l, out_r], [ol, or], rate);
-            // Nothing to tell the host: its notes were reported ended at the swap.
-            let _ = outgoing.engine.take_ended_voices().count();
-            if outgoing.fade.is_done() || outgoing.engine.is_silent() {
-                let mut done = self.engines.outgoing.take().expect("checked above").engine;
-                done.end_all_voices();
-                let _ = done.take_ended_voices().count();
-                if self.engines.discard(done) {
-                    context.execute_background(Task::CollectGarbage);
-                }
+        let outgoing = &mut self.engines.outgoing;
+        let out = [&mut *out_l, &mut *out_r];
+        if let Some(done) = outgoing.add_to(out, &controls, &self.segment_events, drive) {
+            if self.engines.discard(done) {
+                context.execute_background(Task::CollectGarbage);
             }
         }
 
-        // Dry/wet: the effect's input, or the instrument's exciter input when it has one.
-        let dry = [&self.dry[0][..n], &self.dry[1][..n]];
-        if have_input {
-            let wet = self.params.output.dry_wet.value();
-            self.dry_wet.mix([&mut *out_l, &mut *out_r], dry, wet);
-        }
-        // The host's bypass: a fade to the effect's dry input, or to silence.
-        let rate = f32::from_bits(self.shared.sample_rate_bits.load(Ordering::Acquire));
+        let input = have_input.then_some([&self.dry[0][..n], &self.dry[1][..n]]);
+        let wet = self.params.output.dry_wet.value();
         let bypassed = self.params.bypass.value();
-        let dry = K::IS_EFFECT.then_some(dry);
-        self.bypass.apply([out_l, out_r], dry, bypassed, rate);
+        let rate = f32::from_bits(self.shared.sample_rate_bits.load(Ordering::Acquire));
+        let out = [out_l, out_r];
+        self.output
+            .apply(out, input, wet, bypassed, K::IS_EFFECT, rate);
     }
 }
 
@@ -410,7 +376,7 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
             .store(max_block as u32, Ordering::Release);
         self.input = vec![0.0; max_block];
         self.dry = [vec![0.0; max_block], vec![0.0; max_block]];
-        self.outgoing_out = [vec![0.0; max_block], vec![0.0; max_block]];
+        self.engines.outgoing.prepare(max_block);
         self.poly.clear();
         self.onsets = OnsetTrigger::new(rate);
         // Build the engine here, synchronously, so offline renders start with the right bank.
@@ -459,8 +425,7 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
             engine.reset();
         }
         self.onsets.reset();
-        self.dry_wet.reset();
-        self.bypass.reset();
+        self.output.reset();
         // A reset ends every note at once, for the host as well, and forgets the last key: a
         // host's test note before a reset leaves nothing behind.
         self.engines.drop_outgoing();
@@ -525,11 +490,6 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
             self.render_segment(channels, exciter, start, end, context);
             start = end;
         }
-        // No subnormal sample leaves the plugin: a dry path copies what the host sends, and the
-        // plugins after this one may not flush.
-        for channel in channels.iter_mut() {
-            flush_subnormals(&mut channel[..n]);
-        }
         // Modulation of notes that no longer sound (their end lost, or never started) is
         // forgotten.
         if let Some(engine) = self.engines.current.as_ref() {
@@ -545,7 +505,7 @@ impl<K: Kind> Plugin for ModalPlugin<K> {
             );
         }
         let silent = self.engines.current.as_ref().is_none_or(|e| e.is_silent())
-            && self.engines.outgoing.is_none();
+            && !self.engines.outgoing.is_active();
         if silent {
             ProcessStatus::Normal
         } else {

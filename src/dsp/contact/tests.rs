@@ -8,8 +8,9 @@ const RATE: f64 = 48_000.0;
 
 fn render(contact: &mut Contact, speed: f32, force: f32, seconds: f64) -> Vec<f32> {
     let mut out = vec![0.0; (seconds * RATE) as usize];
+    contact.set_speed(speed);
     for block in out.chunks_mut(64) {
-        contact.render(speed, force, block);
+        contact.render(force, block);
     }
     out
 }
@@ -227,6 +228,7 @@ fn rub_modes(modes: &[(f64, f64, f32)], speed: f32, force: f32, seconds: f64) ->
         );
     }
     let mut c = Contact::new(ContactKind::Rub, 0.5, 7, RATE);
+    c.set_speed(speed);
     let zeros = [0.0f32; 64];
     let mut out = Vec::new();
     for _ in 0..(seconds * RATE / 64.0) as usize {
@@ -234,7 +236,7 @@ fn rub_modes(modes: &[(f64, f64, f32)], speed: f32, force: f32, seconds: f64) ->
         bank.process_rubbed(
             Kernel::detect(),
             &zeros,
-            |v, g| c.rub(speed, force, v, g),
+            |v, g| c.rub(force, v, g),
             &mut acc,
         );
         out.extend(acc.iter().map(|a| a.iter().sum::<f32>()));

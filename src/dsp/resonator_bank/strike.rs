@@ -20,6 +20,7 @@ use super::dormant::Dormant;
 use super::ResonatorBank;
 use crate::dsp::masking::power_to_db;
 use crate::dsp::prefetch::{self, prefetch};
+use realfft::num_complex::Complex64;
 
 /// Most pulses kept track of at once: as many as one exciter overlaps.
 pub(super) use crate::dsp::exciter::MAX_PULSES;
@@ -75,8 +76,8 @@ impl Pulse {
         Prepared {
             amplitude: self.amplitude as f64,
             len,
-            rot: C::cis(w0),
-            half_back: C::cis(-0.5 * w0),
+            rot: Complex64::cis(w0),
+            half_back: Complex64::cis(-0.5 * w0),
         }
     }
 }
@@ -89,9 +90,9 @@ pub(super) struct Prepared {
     /// Samples.
     len: u32,
     /// `e^(i w0)`, `w0 = 2 pi / L`.
-    rot: C,
+    rot: Complex64,
     /// `e^(-i w0 / 2)`.
-    half_back: C,
+    half_back: Complex64,
 }
 
 impl Prepared {
@@ -99,17 +100,17 @@ impl Prepared {
     const NONE: Self = Self {
         amplitude: 0.0,
         len: 1,
-        rot: C::ONE,
-        half_back: C::ONE,
+        rot: Complex64::ONE,
+        half_back: Complex64::ONE,
     };
 
     /// `sum_(j = a)^(b - 1) x_j w^(j + 1)` with `w = 1 / p`: the part of the pulse from sample `a`
     /// to `b`, referred to the sample before it starts, for a mode of pole `p`.
-    fn response(&self, p: C, a: u32, b: u32) -> C {
-        let w = C::ONE.div(p);
+    fn response(&self, p: Complex64, a: u32, b: u32) -> Complex64 {
+        let w = Complex64::ONE / p;
         let b = b.min(self.len);
         if a >= b {
-            return C::ZERO;
+            return Complex64::ZERO;
         }
         if self.len == 1 {
             return w.scale(self.amplitude);
@@ -117,36 +118,36 @@ impl Prepared {
         // Raised cosine: 1 - (e^(i w0 (j + 1/2)) + e^(-i w0 (j + 1/2))) / 2, and
         // e^(+-i w0 (j + 1/2)) w^(j + 1) = e^(-+i w0 / 2) (w e^(+-i w0))^(j + 1). The three
         // ratios' powers differ only by whole turns of e^(+-i w0): worked out once.
-        let (first, span) = (w.powi(a + 1), w.powi(b - a));
-        let (ra, rs) = (self.rot.powi(a + 1), self.rot.powi(b - a));
-        let up = geometric(w.mul(self.rot), first.mul(ra), span.mul(rs), a, b);
+        let (first, span) = (powi(w, a + 1), powi(w, b - a));
+        let (ra, rs) = (powi(self.rot, a + 1), powi(self.rot, b - a));
+        let up = geometric(w * self.rot, first * ra, span * rs, a, b);
         let down = geometric(
-            w.mul(self.rot.conj()),
-            first.mul(ra.conj()),
-            span.mul(rs.conj()),
+            w * self.rot.conj(),
+            first * ra.conj(),
+            span * rs.conj(),
             a,
             b,
         );
         let sum = geometric(w, first, span, a, b)
-            .sub(self.half_back.mul(up).scale(0.5))
-            .sub(self.half_back.conj().mul(down).scale(0.5));
+            - (self.half_back * up).scale(0.5)
+            - (self.half_back.conj() * down).scale(0.5);
         sum.scale(self.amplitude / self.len as f64)
     }
 }
 
 /// `sum_(j = a)^(b - 1) u^(j + 1)`, given `u^(a + 1)` and `u^(b - a)`.
-fn geometric(u: C, first: C, span: C, a: u32, b: u32) -> C {
-    let one_minus = C::ONE.sub(u);
+fn geometric(u: Complex64, first: Complex64, span: Complex64, a: u32, b: u32) -> Complex64 {
+    let one_minus = Complex64::ONE - u;
     if one_minus.norm_sqr() < NEAR_ONE * NEAR_ONE {
         let mut term = first;
-        let mut sum = C::ZERO;
+        let mut sum = Complex64::ZERO;
         for _ in a..b {
-            sum = sum.add(term);
-            term = term.mul(u);
+            sum += term;
+            term *= u;
         }
         return sum;
     }
-    first.mul(C::ONE.sub(span)).div(one_minus)
+    first * (Complex64::ONE - span) / one_minus
 }
 
 impl ResonatorBank {
@@ -165,44 +166,90 @@ impl ResonatorBank {
         due: bool,
         mut gain_of: impl FnMut(usize) -> f32,
     ) -> usize {
-        let now = self.clock;
-        // Forget pulses that have ended; what is left of the others, and for how long.
-        let mut kept = 0;
-        let mut span = pulse.samples() as u64;
-        let mut reach = pulse.amplitude.abs();
-        let mut earlier = [(0, Prepared::NONE); MAX_PULSES];
-        for k in 0..self.num_pulses {
-            let (start, old) = self.pulses[k];
-            let end = start + old.samples() as u64;
-            if end > now {
-                self.pulses[kept] = self.pulses[k];
-                earlier[kept] = ((now - start) as u32, old.prepared());
-                span = span.max(end - now);
-                reach += old.amplitude.abs();
-                kept += 1;
-            }
-        }
-        if kept == MAX_PULSES {
-            self.pulses.rotate_left(1);
-            earlier.rotate_left(1);
-            kept -= 1;
-        }
-        self.pulses[kept] = (now, pulse);
-        self.num_pulses = kept + 1;
+        let under_way = self.note_pulse(pulse);
         // Noted even with no dormant modes: a mode this pulse is still playing into when a later
         // strike starts it dormant takes the rest of it.
         if self.num_dormant == 0 {
             return 0;
         }
+        let (n, num_waking) = self.refer_to_records(pulse, &under_way, due, &mut gain_of);
+        let scratch = &mut self.absorb;
+        scratch.run(n);
+        for k in 0..n {
+            let d = &mut self.dormant[scratch.record[k] as usize];
+            d.re = scratch.out_re[k];
+            d.im = scratch.out_im[k];
+            d.snap_db = scratch.out_db[k];
+        }
+        if due {
+            self.earliest_recheck = self.earliest_recheck.min(self.clock);
+        }
+        // Woken as though before this pulse (their old ringing, less what it has not played of
+        // the earlier pulses, fades back in), with this strike's gain; last first, so the
+        // records moved into the places of those woken have been passed already.
+        self.num_pulses = under_way.kept;
+        for k in (0..num_waking).rev() {
+            let r = self.absorb.waking[k] as usize;
+            let mode = self.dormant[r].mode as usize;
+            self.wake_record(r);
+            let slot = self.slot_of_mode[mode] as usize;
+            self.gain[slot] = gain_of(mode);
+        }
+        self.num_pulses = under_way.kept + 1;
+        n
+    }
+
+    /// Notes `pulse`, starting now, among the pulses under way, forgetting those that have
+    /// ended (and the oldest, if there are too many); returns what is left of the earlier ones.
+    fn note_pulse(&mut self, pulse: Pulse) -> UnderWay {
+        let now = self.clock;
+        let mut u = UnderWay {
+            kept: 0,
+            span: pulse.samples() as u64,
+            reach: pulse.amplitude.abs(),
+            earlier: [(0, Prepared::NONE); MAX_PULSES],
+        };
+        for k in 0..self.num_pulses {
+            let (start, old) = self.pulses[k];
+            let end = start + old.samples() as u64;
+            if end > now {
+                self.pulses[u.kept] = self.pulses[k];
+                u.earlier[u.kept] = ((now - start) as u32, old.prepared());
+                u.span = u.span.max(end - now);
+                u.reach += old.amplitude.abs();
+                u.kept += 1;
+            }
+        }
+        if u.kept == MAX_PULSES {
+            self.pulses.rotate_left(1);
+            u.earlier.rotate_left(1);
+            u.kept -= 1;
+        }
+        self.pulses[u.kept] = (now, pulse);
+        self.num_pulses = u.kept + 1;
+        u
+    }
+
+    /// Brings each dormant record to now and works out its share of `pulse` (and, at a change
+    /// of gain, of the pulses `under_way`) into the scratch, for its arithmetic to run over all
+    /// of them at once. Records of modes too damped to refer the pulses back to now are listed
+    /// to be woken instead. Returns how many records took it and how many are to be woken.
+    fn refer_to_records(
+        &mut self,
+        pulse: Pulse,
+        under_way: &UnderWay,
+        due: bool,
+        gain_of: &mut impl FnMut(usize) -> f32,
+    ) -> (usize, usize) {
+        let now = self.clock;
         let unit = Pulse {
             amplitude: 1.0,
             ..pulse
         };
         let prepared = unit.prepared();
         let key = (pulse.shape, unit.samples());
-        // Each record is brought to now and its share of the pulse worked out; the arithmetic
-        // of the new states then runs over all of them at once.
-        // Modes too damped to refer the pulses back to now are computed through them instead.
+        let span = under_way.span;
+        let earlier = &under_way.earlier[..under_way.kept];
         let too_damped = MAX_ABSORB_NEPERS / span as f64;
         let (mut n, mut num_waking) = (0, 0);
         for r in 0..self.num_dormant {
@@ -221,20 +268,17 @@ impl ResonatorBank {
             }
             d.advance_to(now);
             let gain = gain_of(d.mode as usize);
-            let p = C::new(d.p_re, d.p_im);
+            let p = Complex64::new(d.p_re, d.p_im);
             let response = self.responses[d.mode as usize].get(p, key, &prepared);
-            let mut added = response.scale(pulse.amplitude as f64 * gain as f64);
             let change = gain as f64 - d.gain as f64;
             let bounded = d.pulse_left > 0 || d.delta * span as f64 > BOUND_NEPERS;
-            // What the earlier pulses have still to play, at unit gain, referred back to now.
-            let mut rest = C::ZERO;
-            if change != 0.0 || bounded {
-                for &(played, old) in &earlier[..kept] {
-                    rest = rest.add(p.powi(played).mul(old.response(p, played, u32::MAX)));
-                }
-            }
-            // It now comes with this strike's gain.
-            added = added.add(rest.scale(change));
+            let rest = if change != 0.0 || bounded {
+                still_to_play(p, earlier)
+            } else {
+                Complex64::ZERO
+            };
+            // What the earlier pulses have still to play now comes with this strike's gain.
+            let added = response.scale(pulse.amplitude as f64 * gain as f64) + rest.scale(change);
             scratch.phase[n] = d.phase;
             scratch.log_gain[n] = d.log_gain;
             scratch.re[n] = d.re;
@@ -249,8 +293,8 @@ impl ResonatorBank {
             // gain so far) and all the pulses can add.
             if bounded {
                 let (re, im) = d.state();
-                let truth = C::new(re as f64, im as f64).sub(rest.scale(d.gain as f64));
-                let peak = truth.norm_sqr().sqrt() as f32 + gain.abs() * reach;
+                let truth = Complex64::new(re as f64, im as f64) - rest.scale(d.gain as f64);
+                let peak = truth.norm_sqr().sqrt() as f32 + gain.abs() * under_way.reach;
                 d.pulse_peak_db = power_to_db(peak * peak);
                 d.pulse_left = span as u32;
             }
@@ -261,30 +305,7 @@ impl ResonatorBank {
                 self.recheck[r] = now;
             }
         }
-        let scratch = &mut self.absorb;
-        scratch.run(n);
-        for k in 0..n {
-            let d = &mut self.dormant[scratch.record[k] as usize];
-            d.re = scratch.out_re[k];
-            d.im = scratch.out_im[k];
-            d.snap_db = scratch.out_db[k];
-        }
-        if due {
-            self.earliest_recheck = self.earliest_recheck.min(now);
-        }
-        // Woken as though before this pulse (their old ringing, less what it has not played of
-        // the earlier pulses, fades back in), with this strike's gain; last first, so the
-        // records moved into the places of those woken have been passed already.
-        self.num_pulses = kept;
-        for k in (0..num_waking).rev() {
-            let r = self.absorb.waking[k] as usize;
-            let mode = self.dormant[r].mode as usize;
-            self.wake_record(r);
-            let slot = self.slot_of_mode[mode] as usize;
-            self.gain[slot] = gain_of(mode);
-        }
-        self.num_pulses = kept + 1;
-        n
+        (n, num_waking)
     }
 
     /// How many of the pulses given to [`ResonatorBank::absorb_strike`] are still playing.
@@ -299,8 +320,8 @@ impl ResonatorBank {
     /// taken back.
     pub(super) fn undo_pending_pulses(&self, d: &Dormant, state: (f32, f32)) -> (f32, f32) {
         let now = self.clock;
-        let mut z = C::new(state.0 as f64, state.1 as f64);
-        let p = C::new(d.p_re, d.p_im);
+        let mut z = Complex64::new(state.0 as f64, state.1 as f64);
+        let p = Complex64::new(d.p_re, d.p_im);
         for &(start, pulse) in &self.pulses[..self.num_pulses] {
             let played = now.saturating_sub(start);
             if played >= pulse.samples() as u64 {
@@ -308,7 +329,7 @@ impl ResonatorBank {
             }
             // The record holds p^k (z + g sum_all); the truth is p^k (z + g sum_(j<k)).
             let ahead = pulse.prepared().response(p, played as u32, u32::MAX);
-            z = z.sub(p.powi(played as u32).mul(ahead).scale(d.gain as f64));
+            z -= (powi(p, played as u32) * ahead).scale(d.gain as f64);
         }
         let (re, im) = (z.re as f32, z.im as f32);
         // A pulse too big to refer back (`absorb_strike` left the mode silent): nothing to undo.
@@ -326,25 +347,25 @@ impl ResonatorBank {
 #[derive(Debug, Clone, Copy)]
 pub(super) struct CachedResponse {
     /// The pole it was worked out for.
-    pole: C,
+    pole: Complex64,
     /// The pulse's shape and length in samples; a length of 0 in an empty entry, which no pulse
     /// matches.
     key: (PulseShape, u32),
     /// The response.
-    response: C,
+    response: Complex64,
 }
 
 impl CachedResponse {
     /// Nothing cached.
     pub const EMPTY: Self = Self {
-        pole: C::ZERO,
+        pole: Complex64::ZERO,
         key: (PulseShape::Impulse, 0),
-        response: C::ZERO,
+        response: Complex64::ZERO,
     };
 
     /// The response of pole `p` to the unit pulse `prepared` of `key` (shape and length), from
     /// the cache or worked out and kept.
-    fn get(&mut self, p: C, key: (PulseShape, u32), prepared: &Prepared) -> C {
+    fn get(&mut self, p: Complex64, key: (PulseShape, u32), prepared: &Prepared) -> Complex64 {
         if (self.pole, self.key) != (p, key) {
             *self = Self {
                 pole: p,
@@ -356,74 +377,38 @@ impl CachedResponse {
     }
 }
 
-/// A complex number in `f64`, for the few operations above.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct C {
-    /// Real part.
-    re: f64,
-    /// Imaginary part.
-    im: f64,
+/// The pulses under way when a new one comes.
+struct UnderWay {
+    /// How many earlier pulses are still playing.
+    kept: usize,
+    /// Samples from now until the last of them, the new one included, ends.
+    span: u64,
+    /// Sum of their amplitudes' magnitudes, the new one's included.
+    reach: f32,
+    /// Each earlier pulse still playing (the first `kept`): samples it has played, and its
+    /// response constants.
+    earlier: [(u32, Prepared); MAX_PULSES],
 }
 
-impl C {
-    const ZERO: Self = Self { re: 0.0, im: 0.0 };
-    const ONE: Self = Self { re: 1.0, im: 0.0 };
-
-    fn new(re: f64, im: f64) -> Self {
-        Self { re, im }
+/// What the `earlier` pulses (samples played, response constants) have still to play, at unit
+/// gain, referred back to now, for a mode of pole `p`.
+fn still_to_play(p: Complex64, earlier: &[(u32, Prepared)]) -> Complex64 {
+    let mut rest = Complex64::ZERO;
+    for &(played, old) in earlier {
+        rest += powi(p, played) * old.response(p, played, u32::MAX);
     }
+    rest
+}
 
-    /// `e^(i x)`.
-    fn cis(x: f64) -> Self {
-        let (s, c) = x.sin_cos();
-        Self { re: c, im: s }
-    }
-
-    fn add(self, o: Self) -> Self {
-        Self::new(self.re + o.re, self.im + o.im)
-    }
-
-    fn sub(self, o: Self) -> Self {
-        Self::new(self.re - o.re, self.im - o.im)
-    }
-
-    fn mul(self, o: Self) -> Self {
-        Self::new(
-            self.re * o.re - self.im * o.im,
-            self.re * o.im + self.im * o.re,
-        )
-    }
-
-    fn div(self, o: Self) -> Self {
-        let n = o.norm_sqr();
-        Self::new(
-            (self.re * o.re + self.im * o.im) / n,
-            (self.im * o.re - self.re * o.im) / n,
-        )
-    }
-
-    fn conj(self) -> Self {
-        Self::new(self.re, -self.im)
-    }
-
-    fn scale(self, k: f64) -> Self {
-        Self::new(self.re * k, self.im * k)
-    }
-
-    fn norm_sqr(self) -> f64 {
-        self.re * self.re + self.im * self.im
-    }
-
-    /// `self^n` by repeated squaring.
-    fn powi(self, mut n: u32) -> Self {
-        let (mut base, mut acc) = (self, Self::ONE);
-        while n > 0 {
-            if n & 1 == 1 {
-                acc = acc.mul(base);
-            }
-            base = base.mul(base);
-            n >>= 1;
+/// `z^n` by repeated squaring, from one upward by the bits of `n`.
+fn powi(z: Complex64, mut n: u32) -> Complex64 {
+    let (mut base, mut acc) = (z, Complex64::ONE);
+    while n > 0 {
+        if n & 1 == 1 {
+            acc *= base;
         }
-        acc
+        base = base * base;
+        n >>= 1;
     }
+    acc
 }

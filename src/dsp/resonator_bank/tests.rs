@@ -296,7 +296,7 @@ mod strike {
     use super::super::{Pulse, PulseShape};
     use super::*;
     use crate::dsp::masking::power_to_db;
-    use crate::dsp::{Exciter, ExciterKind};
+    use crate::dsp::{Exciter, StrikeKind};
     use std::f64::consts::TAU;
 
     const RATE: f64 = 48_000.0;
@@ -343,17 +343,14 @@ mod strike {
     /// Strikes both banks with `kind` over `len` samples, the pruned one with its odd modes
     /// dormant (taking the strike analytically), wakes everything `wake_after` samples into the
     /// pulse, and compares the states once the ghosts have joined.
-    fn check(kind: ExciterKind, len: u32, wake_after: usize) {
+    fn check(kind: StrikeKind, len: u32, wake_after: usize) {
         let n = 24;
         let (mut pruned, mut reference) = half_dormant(n);
         let mut exciter = Exciter::new(3);
         exciter.strike(kind, 0.7, len);
         let mut x = vec![0.0; 2048];
         exciter.render(&mut x);
-        let shape = match kind {
-            ExciterKind::Impulse => PulseShape::Impulse,
-            _ => PulseShape::Mallet,
-        };
+        let shape = kind.pulse_shape().expect("a pulse known in advance");
         reference.set_gains_with(gain);
         pruned.set_gains_with(gain);
         pruned.absorb_strike(
@@ -405,20 +402,20 @@ mod strike {
 
     #[test]
     fn dormant_modes_take_an_impulse_analytically() {
-        check(ExciterKind::Impulse, 1, 64);
+        check(StrikeKind::Impulse, 1, 64);
     }
 
     #[test]
     fn dormant_modes_take_a_mallet_analytically() {
         for len in [2, 15, 121, 600] {
-            check(ExciterKind::Mallet, len, 700);
+            check(StrikeKind::Mallet, len, 700);
         }
     }
 
     #[test]
     fn a_mode_woken_during_a_pulse_it_took_gets_only_what_was_played() {
         for (len, after) in [(15, 7), (600, 64), (600, 599)] {
-            check(ExciterKind::Mallet, len, after);
+            check(StrikeKind::Mallet, len, after);
         }
     }
 
@@ -442,7 +439,7 @@ mod strike {
                 });
             }
             pruned.absorb_strike(mallet(0.7, len), true, gain);
-            exciter.strike(ExciterKind::Mallet, 0.7, len);
+            exciter.strike(StrikeKind::Mallet, 0.7, len);
             let mut x = vec![0.0; 320];
             exciter.render(&mut x);
             for bank in [&mut pruned, &mut reference] {
@@ -508,10 +505,10 @@ mod strike {
         let (first, second) = (mallet(0.7, 600), mallet(0.4, 300));
         pruned.absorb_strike(first, true, gain);
         let mut exciter = Exciter::new(3);
-        exciter.strike(ExciterKind::Mallet, first.amplitude, first.len);
+        exciter.strike(StrikeKind::Mallet, first.amplitude, first.len);
         let mut x = vec![0.0; 2048];
         exciter.render(&mut x[..t2]);
-        exciter.strike(ExciterKind::Mallet, second.amplitude, second.len);
+        exciter.strike(StrikeKind::Mallet, second.amplitude, second.len);
         exciter.render(&mut x[t2..]);
         let mut pos = 0;
         let go = |bank: &mut ResonatorBank, from: usize, to: usize| {
@@ -630,7 +627,7 @@ mod strike {
             power_to_db(bound * bound)
         );
         let mut exciter = Exciter::new(3);
-        exciter.strike(ExciterKind::Mallet, pulse.amplitude, pulse.len);
+        exciter.strike(StrikeKind::Mallet, pulse.amplitude, pulse.len);
         let mut x = vec![0.0; 640];
         exciter.render(&mut x);
         for bank in [&mut pruned, &mut reference] {
@@ -680,7 +677,7 @@ mod strike {
                 } else {
                     (second, -0.5)
                 };
-                exciter.strike(ExciterKind::Mallet, pulse.amplitude, pulse.len);
+                exciter.strike(StrikeKind::Mallet, pulse.amplitude, pulse.len);
                 reference.set_gains_with(|_| gain);
                 assert_eq!(pruned.absorb_strike(pulse, true, |_| gain), 1);
                 pruned.set_recheck(0, u64::MAX / 2, 0);

@@ -15,96 +15,95 @@ impl Controls {
         let value = value.trim();
         match name {
             "material" => {
-                let m = Material::from_name(value).ok_or_else(|| {
-                    let names: Vec<_> = Material::ALL.iter().map(|m| m.name()).collect();
-                    format!(
-                        "material: expected one of {}, found \"{value}\"",
-                        names.join(", ")
-                    )
-                })?;
-                self.set_material(m);
-                Ok(())
+                let names = Material::ALL.iter().map(|m| m.name());
+                self.set_material(one_of(name, value, Material::from_name(value), names)?);
             }
             "exciter" => {
-                self.exciter = ExciterKind::from_name(value).ok_or_else(|| {
-                    let names: Vec<_> = ExciterKind::ALL.iter().map(|k| k.name()).collect();
-                    format!(
-                        "exciter: expected one of {}, found \"{value}\"",
-                        names.join(", ")
-                    )
-                })?;
-                Ok(())
+                let names = ExciterKind::ALL.iter().map(|k| k.name());
+                self.exciter = one_of(name, value, ExciterKind::from_name(value), names)?;
             }
             "mod_wheel_target" | "pressure_target" => {
-                let target = ExpressionTarget::from_name(value).ok_or_else(|| {
-                    let names: Vec<_> = ExpressionTarget::ALL.iter().map(|t| t.name()).collect();
-                    format!(
-                        "{name}: expected one of {}, found \"{value}\"",
-                        names.join(", ")
-                    )
-                })?;
+                let names = ExpressionTarget::ALL.iter().map(|t| t.name());
+                let target = one_of(name, value, ExpressionTarget::from_name(value), names)?;
                 if name == "mod_wheel_target" {
                     self.mod_wheel_target = target;
                 } else {
                     self.pressure_target = target;
                 }
-                Ok(())
             }
             "pruning" | "mpe" => {
-                let on = match value.to_ascii_lowercase().as_str() {
-                    "on" | "true" | "1" => true,
-                    "off" | "false" | "0" => false,
-                    _ => {
-                        return Err(format!(
-                            "{name}: expected on or off (true, false, 1, 0), found \"{value}\""
-                        ))
-                    }
-                };
+                let on = on_or_off(name, value)?;
                 if name == "mpe" {
                     self.mpe = on;
                 } else {
                     self.pruning = on;
                 }
-                Ok(())
             }
-            "material_q" if value == "authored" => {
-                self.material_q = None;
-                Ok(())
-            }
+            "material_q" if value == "authored" => self.material_q = None,
             "material_q" => {
                 let q = parse_in_range(name, value, MATERIAL_Q_RANGE.0, MATERIAL_Q_RANGE.1)?;
                 self.material_q = Some(q);
-                Ok(())
             }
-            _ => {
-                let spec = NUMERIC_CONTROLS
-                    .iter()
-                    .find(|s| s.name == name)
-                    .ok_or_else(|| {
-                        let mut names: Vec<_> = NUMERIC_CONTROLS.iter().map(|s| s.name).collect();
-                        names.extend([
-                            "material_q",
-                            "material",
-                            "exciter",
-                            "mod_wheel_target",
-                            "pressure_target",
-                        ]);
-                        format!(
-                            "unknown control \"{name}\"; known controls: {}",
-                            names.join(", ")
-                        )
-                    })?;
-                let v = parse_in_range(name, value, spec.min, spec.max)?;
-                if spec.integer && v.fract() != 0.0 {
-                    return Err(format!(
-                        "{name}: expected a whole number from {} to {}, found {v}",
-                        spec.min, spec.max
-                    ));
-                }
-                (spec.set)(self, v);
-                Ok(())
-            }
+            _ => self.set_numeric(name, value)?,
         }
+        Ok(())
+    }
+
+    /// Sets numeric control `name` (one of [`NUMERIC_CONTROLS`]) from text, within its range.
+    fn set_numeric(&mut self, name: &str, value: &str) -> Result<(), String> {
+        let spec = NUMERIC_CONTROLS
+            .iter()
+            .find(|s| s.name == name)
+            .ok_or_else(|| {
+                let mut names: Vec<_> = NUMERIC_CONTROLS.iter().map(|s| s.name).collect();
+                names.extend([
+                    "material_q",
+                    "material",
+                    "exciter",
+                    "mod_wheel_target",
+                    "pressure_target",
+                ]);
+                format!(
+                    "unknown control \"{name}\"; known controls: {}",
+                    names.join(", ")
+                )
+            })?;
+        let v = parse_in_range(name, value, spec.min, spec.max)?;
+        if spec.integer && v.fract() != 0.0 {
+            return Err(format!(
+                "{name}: expected a whole number from {} to {}, found {v}",
+                spec.min, spec.max
+            ));
+        }
+        (spec.set)(self, v);
+        Ok(())
+    }
+}
+
+/// The choice `found` for `value` of control `name`, or an error listing its `names`.
+fn one_of<T>(
+    name: &str,
+    value: &str,
+    found: Option<T>,
+    names: impl Iterator<Item = &'static str>,
+) -> Result<T, String> {
+    found.ok_or_else(|| {
+        let names: Vec<_> = names.collect();
+        format!(
+            "{name}: expected one of {}, found \"{value}\"",
+            names.join(", ")
+        )
+    })
+}
+
+/// A switch's `value` of control `name`: on or off (true, false, 1, 0), in any case.
+fn on_or_off(name: &str, value: &str) -> Result<bool, String> {
+    match value.to_ascii_lowercase().as_str() {
+        "on" | "true" | "1" => Ok(true),
+        "off" | "false" | "0" => Ok(false),
+        _ => Err(format!(
+            "{name}: expected on or off (true, false, 1, 0), found \"{value}\""
+        )),
     }
 }
 
