@@ -133,18 +133,30 @@ fn main() {
         .into_iter()
         .filter(|k| k.is_supported())
         .collect();
+    print_kernels(&kernels, work);
+    println!();
+    print_driven(&kernels, work);
+    println!();
+    print_engine(&kernels, engine_seconds);
+    println!();
+    print_contacts(engine_seconds);
+}
+
+/// Mode-samples per second of each kernel at bank sizes from 16 to 16,384 modes, and the
+/// speed-ups over the scalar kernel.
+fn print_kernels(kernels: &[Kernel], work: usize) {
     println!(
         "Resonator kernels, mode-samples per second (one core, {BLOCK}-sample blocks, no input):"
     );
     print!("{:>8}", "modes");
-    for k in &kernels {
+    for k in kernels {
         print!("{:>14}", k.name());
     }
     println!("{:>12}{:>12}", "avx2/scalar", "best/scalar");
     for &n in &[16usize, 32, 48, 64, 256, 1024, 4096, 16384] {
         print!("{n:>8}");
         let mut figures = Vec::new();
-        for &k in &kernels {
+        for &k in kernels {
             let w = if k == Kernel::Scalar { work / 8 } else { work };
             let v = mode_samples_per_s(k, n, w, false);
             figures.push((k, v));
@@ -159,9 +171,12 @@ fn main() {
         }
         println!("{:>12.1}", best / scalar);
     }
-    println!();
+}
+
+/// Each kernel driven by input on every sample against left to ring.
+fn print_driven(kernels: &[Kernel], work: usize) {
     println!("Driven by input on every sample, 4096 modes (one operation more per mode group):");
-    for &k in &kernels {
+    for &k in kernels {
         let w = if k == Kernel::Scalar { work / 8 } else { work };
         let (quiet, driven) = (
             mode_samples_per_s(k, 4096, w, false),
@@ -175,9 +190,12 @@ fn main() {
             quiet / driven
         );
     }
-    println!();
+}
+
+/// The whole engine's real-time factor with each kernel, still and under a moving pitch bend.
+fn print_engine(kernels: &[Kernel], engine_seconds: f64) {
     println!("Engine, 16 voices x 256 modes, 48 kHz, {BLOCK}-sample blocks:");
-    for &k in &kernels {
+    for &k in kernels {
         let (rt, live) = engine_realtime_factor(k, false, engine_seconds);
         let (rt_sweep, _) = engine_realtime_factor(k, true, engine_seconds);
         println!(
@@ -187,7 +205,10 @@ fn main() {
             rt_sweep
         );
     }
-    println!();
+}
+
+/// One voice held in each contact against one struck.
+fn print_contacts(engine_seconds: f64) {
     println!(
         "One voice of the same bank ({} modes), struck and ringing against held in contact:",
         common::bench_bank().modes.len()
