@@ -694,7 +694,7 @@ fn subset_gains(gram: &[f64], rhs: &[f64], subset: &[usize]) -> Vec<f64> {
 mod tests {
     use super::super::subband::{layout, split, Splitter};
     use super::*;
-    use crate::dsp::rng::Rng;
+    use crate::rng::Rng;
 
     /// Frequency in Hz, decay in 1/s and gain of each of three modes.
     const TRUTH: [(f64, f64, f64); 3] = [
