@@ -13,7 +13,6 @@ use modal_resonator::engine::{Controls, PreparedBank};
 
 use modal_resonator::bank::{Bank, Mode, Position};
 use modal_resonator::render::{render, resynthesize, Note, CUT_FADE_S};
-use modal_resonator::rng::Rng;
 
 const RATE: u32 = 48_000;
 
@@ -101,12 +100,18 @@ fn truth_bank() -> Bank {
     bank
 }
 
-/// Gaussian white noise, seeded (Box-Muller).
-fn gaussian_noise(len: usize, seed: u32) -> Vec<f64> {
-    let mut rng = Rng::new(seed);
+/// Gaussian white noise from a seeded xorshift generator (Box-Muller).
+fn gaussian_noise(len: usize, seed: u64) -> Vec<f64> {
+    let mut state = seed.max(1);
+    let mut uniform = || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        ((state >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    };
     (0..len)
         .map(|_| {
-            let (u, v) = (rng.uniform(), rng.uniform());
+            let (u, v) = (uniform(), uniform());
             (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
         })
         .collect()
@@ -154,12 +159,12 @@ fn engine(bank: &Bank, position: usize, sample_rate_hz: u32, len: usize) -> Vec<
 }
 
 /// The recording of position `k`: a lead-in, the render, and noise `snr_db` below it.
-fn noisy_recording(bank: &Bank, k: usize, snr_db: f64, seed: u32) -> Recording {
+fn noisy_recording(bank: &Bank, k: usize, snr_db: f64, seed: u64) -> Recording {
     noisy_recording_at(bank, k, snr_db, seed, RATE)
 }
 
 /// [`noisy_recording`] at `rate` Hz.
-fn noisy_recording_at(bank: &Bank, k: usize, snr_db: f64, seed: u32, rate: u32) -> Recording {
+fn noisy_recording_at(bank: &Bank, k: usize, snr_db: f64, seed: u64, rate: u32) -> Recording {
     let clean = clean_render_at(bank, k, rate);
     let rms = (clean.iter().map(|v| v * v).sum::<f64>() / clean.len() as f64).sqrt();
     let sigma = rms * 10f64.powf(-snr_db / 20.0);
@@ -232,7 +237,7 @@ fn the_renderer_used_here_matches_the_resyntheses_of_the_renderer_and_the_fit() 
 fn a_known_bank_is_recovered_from_noisy_renders() {
     let truth = truth_bank();
     let recordings: Vec<Recording> = (0..2)
-        .map(|k| noisy_recording(&truth, k, SNR_DB, 17 + k as u32))
+        .map(|k| noisy_recording(&truth, k, SNR_DB, 17 + k as u64))
         .collect();
     let options = FitOptions {
         name: "recovered".into(),
@@ -377,7 +382,7 @@ fn a_known_bank_is_recovered_at_any_common_sample_rate() {
         let mut truth = truth_bank();
         truth.modes.retain(|m| m.freq_hz < 0.4 * f64::from(rate));
         let recordings: Vec<Recording> = (0..2)
-            .map(|k| noisy_recording_at(&truth, k, SNR_DB, 17 + k as u32, rate))
+            .map(|k| noisy_recording_at(&truth, k, SNR_DB, 17 + k as u64, rate))
             .collect();
         let fit = fit_bank(&recordings, &FitOptions::default()).unwrap().bank;
         let strongest = fit
@@ -575,7 +580,7 @@ fn bad_names_and_options_are_errors() {
 fn the_mode_count_and_frequency_range_are_respected() {
     let bank = truth_bank();
     let recordings: Vec<Recording> = (0..2)
-        .map(|k| noisy_recording(&bank, k, SNR_DB, 30 + k as u32))
+        .map(|k| noisy_recording(&bank, k, SNR_DB, 30 + k as u64))
         .collect();
     let options = FitOptions {
         max_modes: 4,
@@ -623,7 +628,7 @@ fn the_mode_count_and_frequency_range_are_respected() {
 
 /// The bank of `modes` (frequency, decay, gains at the two ends), fitted from its noisy renders
 /// at both ends.
-fn fit_of(modes: &[(f64, f64, [f64; 2])], seed: u32) -> Bank {
+fn fit_of(modes: &[(f64, f64, [f64; 2])], seed: u64) -> Bank {
     let mut bank = Bank::new("pair", common::two_ends());
     for &(freq_hz, decay_per_s, gains) in modes {
         bank.modes.push(Mode {
@@ -633,7 +638,7 @@ fn fit_of(modes: &[(f64, f64, [f64; 2])], seed: u32) -> Bank {
         });
     }
     let recordings: Vec<Recording> = (0..2)
-        .map(|k| noisy_recording(&bank, k, SNR_DB, seed + k as u32))
+        .map(|k| noisy_recording(&bank, k, SNR_DB, seed + k as u64))
         .collect();
     fit_bank(&recordings, &FitOptions::default()).unwrap().bank
 }
@@ -726,7 +731,7 @@ fn the_fidelity_score_tells_a_wrong_bank_from_the_right_one() {
     // detuned, or decaying twice as fast, it scores far worse.
     let truth = truth_bank();
     let recordings: Vec<Recording> = (0..2)
-        .map(|k| noisy_recording(&truth, k, SNR_DB, 90 + k as u32))
+        .map(|k| noisy_recording(&truth, k, SNR_DB, 90 + k as u64))
         .collect();
     let options = FitOptions::default();
     let score = |bank: &Bank| compare(bank, &recordings, &options, engine).unwrap();
