@@ -250,7 +250,7 @@ fn group_points(
     let mut turns = vec![Complex64::new(1.0, 0.0); modes.len()];
     let mut bins = vec![Complex64::new(0.0, 0.0); g.bins.len()];
     let mut points: Vec<(f64, f64)> = Vec::new();
-    for j in 0..synthesis.power.len() {
+    for ((frame, rec_power), time_s) in synthesis.power.iter().zip(rec_power).zip(&frames.time_s) {
         bins.fill(Complex64::new(0.0, 0.0));
         for ((positive, negative), u) in spectra.iter().zip(&turns) {
             for ((b, p), n) in bins.iter_mut().zip(positive).zip(negative) {
@@ -261,10 +261,10 @@ fn group_points(
             *u *= step;
         }
         let own: f64 = bins.iter().map(|b| b.norm_sqr()).sum();
-        let total: f64 = synthesis.power[j][g.bins.clone()].iter().sum();
-        let wanted = rec_power[j] - (total - own);
+        let total: f64 = frame[g.bins.clone()].iter().sum();
+        let wanted = rec_power - (total - own);
         if wanted >= ABOVE_NOISE * noise && own >= MIN_SHARE * total && own > 0.0 {
-            points.push((frames.time_s[j], 10.0 * (wanted / own).log10()));
+            points.push((*time_s, 10.0 * (wanted / own).log10()));
         }
     }
     points
