@@ -55,8 +55,8 @@ use voice::{PendingStrike, Tuning, Voice, VoiceOverrides, VoiceState};
 
 use crate::bank::format::MIN_DECAY_PER_S;
 use crate::dsp::denormal::FlushDenormals;
-use crate::dsp::rng::Rng;
 use crate::dsp::{Kernel, COLUMNS};
+use crate::rng::Rng;
 use crate::units::{db_to_gain, t60_to_decay};
 
 /// Samples between control updates: smoothing steps, coefficient updates and mode truncation.

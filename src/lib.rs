@@ -12,6 +12,7 @@ pub mod engine;
 pub mod params;
 pub mod plugin;
 pub mod render;
+pub mod rng;
 pub mod units;
 
 pub use plugin::{ModalResonator, ModalResonatorFx};

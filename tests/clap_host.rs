@@ -411,7 +411,7 @@ fn the_plugins_play_at_any_rate_a_host_asks() {
 fn no_subnormal_sample_leaves_either_plugin_whatever_the_host_does() {
     // Randomised parameters, rates, block sizes and notes, with subnormal input on the input
     // port between bursts of noise: every output sample is finite and not subnormal.
-    let mut rng = modal_resonator::dsp::rng::Rng::new(0x9e37_79b9);
+    let mut rng = modal_resonator::rng::Rng::new(0x9e37_79b9);
     let mut next = move || rng.next_u32() as f64 / u32::MAX as f64;
     let rates = [
         1_234.567_8,

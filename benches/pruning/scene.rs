@@ -5,6 +5,7 @@
 use modal_resonator::authoring::materials::{self, Material};
 use modal_resonator::authoring::shapes::{ModeLimits, RectangularPlate, Shape, MAX_AUDIBLE_HZ};
 use modal_resonator::bank::{Bank, Mode, Position};
+use modal_resonator::rng::Rng;
 
 use crate::RATE_HZ;
 
@@ -159,15 +160,10 @@ pub fn scene_bank(objects: &[Object]) -> Bank {
     bank
 }
 
-/// Uniform numbers in `0..1` from a seeded xorshift generator.
-fn uniform(seed: u64) -> impl FnMut() -> f64 {
-    let mut s = seed;
-    move || {
-        s ^= s << 13;
-        s ^= s >> 7;
-        s ^= s << 17;
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    }
+/// Uniform numbers in `0..1`, seeded.
+fn uniform(seed: u32) -> impl FnMut() -> f64 {
+    let mut rng = Rng::new(seed);
+    move || rng.uniform()
 }
 
 /// One impact: sample, object, velocity.
@@ -175,7 +171,7 @@ pub type Impact = (usize, usize, f32);
 
 /// A Poisson rain of impacts on objects chosen by exposure, energies drawn from a 1/E law
 /// (log-uniform over `ENERGY_RANGE`), seeded.
-pub fn hail(objects: &[Object], seconds: f64, seed: u64) -> Vec<Impact> {
+pub fn hail(objects: &[Object], seconds: f64, seed: u32) -> Vec<Impact> {
     let mut uniform = uniform(seed);
     let total: f64 = objects.iter().map(|o| o.exposure).sum();
     let mut t = 0.0;
@@ -262,7 +258,7 @@ const DENSE_KEYS: [u8; 11] = [36, 39, 41, 43, 46, 48, 51, 53, 55, 58, 60];
 
 /// Chords and rolls on the sheet, seeded: a chord of four keys every 0.75 s, and between two
 /// chords a roll of six strikes ten a second on one key, softer.
-pub fn chords_and_rolls(seconds: f64, seed: u64) -> Vec<Hit> {
+pub fn chords_and_rolls(seconds: f64, seed: u32) -> Vec<Hit> {
     let mut uniform = uniform(seed);
     let key =
         |u: f64| DENSE_KEYS[((u * DENSE_KEYS.len() as f64) as usize).min(DENSE_KEYS.len() - 1)];

@@ -60,6 +60,8 @@
 
 use std::f64::consts::TAU;
 
+use crate::rng::{bipolar, hash};
+
 /// Time constant of the speed and force smoothing, in seconds.
 pub const SMOOTHING_S: f64 = 0.005;
 
@@ -269,8 +271,8 @@ impl Contact {
         let mut bump_place = [0.0f64; BUMPS];
         for j in 0..BUMPS {
             let (a, b) = (
-                unit(hash(seed ^ 0xB0B, j as u32, 1)),
-                unit(hash(seed ^ 0xB0B, j as u32, 2)),
+                bipolar(hash(seed ^ 0xB0B, j as u32, 1)),
+                bipolar(hash(seed ^ 0xB0B, j as u32, 2)),
             );
             bump_height[j] = roughness * (1.0 + 0.5 * a);
             bump_place[j] = (j as f64 + 0.5 * roughness as f64 * b as f64) / BUMPS as f64;
@@ -528,26 +530,9 @@ fn lattice_heights(seed: u32, octave: u32, i: u64) -> (f32, f32) {
     let mask = (1u64 << (PERIOD_BITS + octave)) - 1;
     // Hashed on the low 32 bits and the octave: distinct within a period of up to 2^32 cells.
     (
-        unit(hash(seed, octave, i as u32)),
-        unit(hash(seed, octave, ((i + 1) & mask) as u32)),
+        bipolar(hash(seed, octave, i as u32)),
+        bipolar(hash(seed, octave, ((i + 1) & mask) as u32)),
     )
-}
-
-/// A 32-bit hash of a lattice point.
-#[inline]
-fn hash(seed: u32, octave: u32, i: u32) -> u32 {
-    let mut h = seed ^ octave.wrapping_mul(0x9E37_79B9) ^ i.wrapping_mul(0x85EB_CA6B);
-    h ^= h >> 16;
-    h = h.wrapping_mul(0x7FEB_352D);
-    h ^= h >> 15;
-    h = h.wrapping_mul(0x846C_A68B);
-    h ^ (h >> 16)
-}
-
-/// A hash mapped onto [-1, 1).
-#[inline]
-fn unit(h: u32) -> f32 {
-    (h >> 8) as f32 * (2.0 / 16_777_216.0) - 1.0
 }
 
 #[cfg(test)]

@@ -8,7 +8,7 @@
 use std::f32::consts::TAU;
 
 use super::contact::{Contact, ContactKind, ContactMotion};
-use super::rng::Rng;
+use crate::rng::Rng;
 
 /// Level of a contact's force against a strike's: a scrape at 0.5 m/s and the default force
 /// (0.7), held, drives a bank to about the level of the first half second of a mallet strike at

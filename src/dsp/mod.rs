@@ -15,7 +15,6 @@ pub mod onset;
 pub mod prefetch;
 pub mod pruning;
 pub mod resonator_bank;
-pub mod rng;
 
 pub use coeffs::ModeCoeffs;
 pub use exciter::{Excitation, Exciter, ExciterKind, StrikeKind};

@@ -12,6 +12,7 @@ use std::sync::Arc;
 
 use modal_resonator::bank::{Bank, Mode, Position};
 use modal_resonator::engine::{Engine, NoteEvent, PreparedBank};
+use modal_resonator::rng::Rng;
 
 /// A 1-D bank of `modes` given as `(freq_hz, decay_per_s, gain)`, with a single position.
 pub fn simple_bank(modes: &[(f64, f64, f64)]) -> Bank {
@@ -61,13 +62,8 @@ pub fn dense_bank(n: usize, f0: f64) -> Bank {
         },
     ];
     let mut bank = Bank::new("dense", positions);
-    let mut seed = 12345u32;
-    let mut rnd = || {
-        seed ^= seed << 13;
-        seed ^= seed >> 17;
-        seed ^= seed << 5;
-        seed as f64 / u32::MAX as f64
-    };
+    let mut rng = Rng::new(12345);
+    let mut rnd = || f64::from(rng.next_u32()) / f64::from(u32::MAX);
     bank.modes = (0..n)
         .map(|i| {
             let f = f0 * (1.0 + i as f64 * (0.7 + 0.6 * rnd()));

@@ -140,25 +140,11 @@ fn each_bin<const DERIVATIVES: bool>(
         scale,
     } = *pole;
     for j in 0..n {
-        let (wr, wi, t) = (w_re[j], w_im[j], taper[j]);
-        let (wlr, wli) = (wl_re[j], wl_im[j]);
-        // a = e^s w, a_L = e^(sL) w_L, and with the conjugate pole ac, alc.
-        let (ar, ai) = (es.re * wr - es.im * wi, es.re * wi + es.im * wr);
-        let (alr, ali) = (esl.re * wlr - esl.im * wli, esl.re * wli + esl.im * wlr);
-        let (acr, aci) = (es.re * wr + es.im * wi, es.re * wi - es.im * wr);
-        let (alcr, alci) = (esl.re * wlr + esl.im * wli, esl.re * wli - esl.im * wlr);
-        // 1 / (1 - a), 1 / (1 - ac).
-        let (xr, xi) = (1.0 - ar, -ai);
-        let r = 1.0 / (xr * xr + xi * xi);
-        let (ir, ii) = (xr * r, -xi * r);
-        let (xcr, xci) = (1.0 - acr, -aci);
-        let rc = 1.0 / (xcr * xcr + xci * xci);
-        let (icr, ici) = (xcr * rc, -xci * rc);
-        // P and Pc.
-        let (nr, ni) = (1.0 - alr, -ali);
-        let (pr, pi) = (nr * ir - ni * ii, nr * ii + ni * ir);
-        let (ncr, nci) = (1.0 - alcr, -alci);
-        let (pcr, pci) = (ncr * icr - nci * ici, ncr * ici + nci * icr);
+        let (w, wl, t) = ((w_re[j], w_im[j]), (wl_re[j], wl_im[j]), taper[j]);
+        // The pole and its conjugate.
+        let b = BinTerms::new((es.re, es.im), (esl.re, esl.im), w, wl);
+        let c = BinTerms::new((es.re, -es.im), (esl.re, -esl.im), w, wl);
+        let ((pr, pi), (pcr, pci)) = (b.p, c.p);
         // u = q P + qc Pc.
         let ur = q.re * pr - q.im * pi + qc.re * pcr - qc.im * pci;
         let ui = q.re * pi + q.im * pr + qc.re * pci + qc.im * pcr;
@@ -166,14 +152,7 @@ fn each_bin<const DERIVATIVES: bool>(
         unit[j].re += ur * tg;
         unit[j].im += ui * tg;
         if DERIVATIVES {
-            // dP = (a P - L a_L) / (1 - a), and for the conjugate pole.
-            let (yr, yi) = (ar * pr - ai * pi - len * alr, ar * pi + ai * pr - len * ali);
-            let (dpr, dpi) = (yr * ir - yi * ii, yr * ii + yi * ir);
-            let (ycr, yci) = (
-                acr * pcr - aci * pci - len * alcr,
-                acr * pci + aci * pcr - len * alci,
-            );
-            let (dpcr, dpci) = (ycr * icr - yci * ici, ycr * ici + yci * icr);
+            let ((dpr, dpi), (dpcr, dpci)) = (b.dp(len), c.dp(len));
             // e = q (dP - P tau), ec = qc (dPc - Pc tau).
             let (fr, fi) = (dpr - pr * tau, dpi - pi * tau);
             let (er, ei) = (q.re * fr - q.im * fi, q.re * fi + q.im * fr);
@@ -194,6 +173,47 @@ fn each_bin<const DERIVATIVES: bool>(
             dt[j].re -= vr * g;
             dt[j].im -= vi * g;
         }
+    }
+}
+
+/// One pole's terms at one bin, as (real, imaginary) pairs in real arithmetic so that the loop
+/// over the bins vectorises.
+struct BinTerms {
+    /// `a = e^s w^k`.
+    a: (f64, f64),
+    /// `a_L = e^(sL) w^(kL)`.
+    al: (f64, f64),
+    /// `1 / (1 - a)`.
+    inv: (f64, f64),
+    /// `P = (1 - a_L) / (1 - a)`.
+    p: (f64, f64),
+}
+
+impl BinTerms {
+    /// The terms of the pole `e^s = es` (and `e^(sL) = esl`) at the bin where `w^k = w` and
+    /// `w^(kL) = wl`.
+    #[inline(always)]
+    fn new(es: (f64, f64), esl: (f64, f64), w: (f64, f64), wl: (f64, f64)) -> Self {
+        let (ar, ai) = (es.0 * w.0 - es.1 * w.1, es.0 * w.1 + es.1 * w.0);
+        let (alr, ali) = (esl.0 * wl.0 - esl.1 * wl.1, esl.0 * wl.1 + esl.1 * wl.0);
+        let (xr, xi) = (1.0 - ar, -ai);
+        let r = 1.0 / (xr * xr + xi * xi);
+        let (ir, ii) = (xr * r, -xi * r);
+        let (nr, ni) = (1.0 - alr, -ali);
+        Self {
+            a: (ar, ai),
+            al: (alr, ali),
+            inv: (ir, ii),
+            p: (nr * ir - ni * ii, nr * ii + ni * ir),
+        }
+    }
+
+    /// `dP/ds = (a P - L a_L) / (1 - a)` for a sound `len` samples long.
+    #[inline(always)]
+    fn dp(&self, len: f64) -> (f64, f64) {
+        let ((ar, ai), (alr, ali), (ir, ii), (pr, pi)) = (self.a, self.al, self.inv, self.p);
+        let (yr, yi) = (ar * pr - ai * pi - len * alr, ar * pi + ai * pr - len * ali);
+        (yr * ir - yi * ii, yr * ii + yi * ir)
     }
 }
 

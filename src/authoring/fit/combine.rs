@@ -56,6 +56,35 @@ struct Member {
 /// The bank's modes from the modes of every recording: at most `max_modes`, the strongest by
 /// energy (seed 000 eq. 5.15), by frequency.
 pub fn combine(analyses: &[Analysis], max_modes: usize) -> Vec<Combined> {
+    let clusters = clusters(members(analyses));
+    let mut modes = merged(&clusters);
+    if analyses.len() == 1 {
+        // One recording: the gains its analysis measured, each mode with the strike's phase,
+        // less those under a noise floor the user gave.
+        let a = &analyses[0];
+        for (m, c) in modes.iter_mut().zip(&clusters) {
+            let heard = !a.floor_given() || c[0].gain.abs() >= a.floor_amplitude(m.freq_hz);
+            m.gains = vec![if heard { c[0].gain } else { 0.0 }];
+        }
+    } else {
+        measure_gains(analyses, &mut modes);
+    }
+    modes.retain(|m| m.gains.iter().any(|&g| g != 0.0));
+    drop_inaudible(analyses, &mut modes);
+    if modes.len() > max_modes {
+        modes.sort_by(|a, b| energy(b).total_cmp(&energy(a)));
+        modes.truncate(max_modes);
+        modes.sort_by(|a, b| a.freq_hz.total_cmp(&b.freq_hz));
+        // Without the dropped modes the kept ones take back the energy they shared.
+        if analyses.len() > 1 {
+            measure_gains(analyses, &mut modes);
+        }
+    }
+    modes
+}
+
+/// Every recording's modes, by frequency.
+fn members(analyses: &[Analysis]) -> Vec<Member> {
     let mut members: Vec<Member> = analyses
         .iter()
         .enumerate()
@@ -71,11 +100,14 @@ pub fn combine(analyses: &[Analysis], max_modes: usize) -> Vec<Combined> {
         })
         .collect();
     members.sort_by(|a, b| a.freq_hz.total_cmp(&b.freq_hz));
+    members
+}
 
-    // Clusters along the frequency axis: a finding joins the nearest cluster closer than the
-    // limen to it that has no finding of its recording yet. Two modes found in one recording
-    // stay two, however close: the analysis resolved them, and a beating pair or a fast-then-slow
-    // decay is heard as such.
+/// Clusters along the frequency axis of `members` (by frequency): a finding joins the nearest
+/// cluster closer than the limen to it that has no finding of its recording yet. Two modes found
+/// in one recording stay two, however close: the analysis resolved them, and a beating pair or a
+/// fast-then-slow decay is heard as such.
+fn clusters(members: Vec<Member>) -> Vec<Vec<Member>> {
     let mut clusters: Vec<Vec<Member>> = Vec::new();
     for m in members {
         let limen = difference_limen_hz(m.freq_hz);
@@ -93,7 +125,12 @@ pub fn combine(analyses: &[Analysis], max_modes: usize) -> Vec<Combined> {
             None => clusters.push(vec![m]),
         }
     }
-    let mut modes: Vec<Combined> = clusters
+    clusters
+}
+
+/// One mode of each cluster, its gains still to be measured.
+fn merged(clusters: &[Vec<Member>]) -> Vec<Combined> {
+    clusters
         .iter()
         .map(|c| {
             let best = c
@@ -111,24 +148,14 @@ pub fn combine(analyses: &[Analysis], max_modes: usize) -> Vec<Combined> {
                 findings: c.len(),
             }
         })
-        .collect();
+        .collect()
+}
 
-    if analyses.len() == 1 {
-        // One recording: the gains its analysis measured, each mode with the strike's phase,
-        // less those under a noise floor the user gave.
-        let a = &analyses[0];
-        for (m, c) in modes.iter_mut().zip(&clusters) {
-            let heard = !a.floor_given() || c[0].gain.abs() >= a.floor_amplitude(m.freq_hz);
-            m.gains = vec![if heard { c[0].gain } else { 0.0 }];
-        }
-    } else {
-        measure_gains(analyses, &mut modes);
-    }
-    modes.retain(|m| m.gains.iter().any(|&g| g != 0.0));
-    // The bank keeps the analysis' rule for inaudible modes (energy over the sound, the longest
-    // recording's here): gains measured again over several recordings can leave one far below
-    // the others (a click dying within a millisecond, its gain taken from the start of each
-    // recording).
+/// Drops the modes the analysis' rule for inaudible modes drops (energy over the sound, the
+/// longest recording's here): gains measured again over several recordings can leave one far
+/// below the others (a click dying within a millisecond, its gain taken from the start of each
+/// recording).
+fn drop_inaudible(analyses: &[Analysis], modes: &mut Vec<Combined>) {
     let sound_s = analyses
         .iter()
         .map(|a| a.signal.len() as f64 / a.sample_rate_hz)
@@ -140,16 +167,6 @@ pub fn combine(analyses: &[Analysis], max_modes: usize) -> Vec<Combined> {
     let loudest = modes.iter().map(heard).fold(0.0, f64::max);
     let floor = loudest * 10f64.powf(-INAUDIBLE_DB / 10.0);
     modes.retain(|m| heard(m) >= floor);
-    if modes.len() > max_modes {
-        modes.sort_by(|a, b| energy(b).total_cmp(&energy(a)));
-        modes.truncate(max_modes);
-        modes.sort_by(|a, b| a.freq_hz.total_cmp(&b.freq_hz));
-        // Without the dropped modes the kept ones take back the energy they shared.
-        if analyses.len() > 1 {
-            measure_gains(analyses, &mut modes);
-        }
-    }
-    modes
 }
 
 /// Mean of `value` over a cluster, weighted by the members' weights.

@@ -106,7 +106,7 @@ fn shift_invariance(u: &[Complex64], rows: usize, order: usize) -> Vec<Complex64
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dsp::rng::Rng;
+    use crate::rng::Rng;
 
     #[test]
     fn resolves_two_close_damped_exponentials_in_noise() {

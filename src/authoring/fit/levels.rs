@@ -91,34 +91,66 @@ fn erb_hz(freq_hz: f64) -> f64 {
     24.7 * (4.37 * freq_hz / 1000.0 + 1.0)
 }
 
+/// The frames the recording and the resynthesis are compared in.
+struct Frames {
+    /// The recording's spectrogram.
+    recording: Spectrogram,
+    /// The window of a frame.
+    window: Vec<f64>,
+    /// Sum of the window's squares: a noise's power in a bin of a frame over its density.
+    sum_sq: f64,
+    /// Samples from one frame to the next.
+    hop: usize,
+    /// Time of each frame's centre after the first sample, in seconds.
+    time_s: Vec<f64>,
+}
+
+impl Frames {
+    /// The frames of `a`'s recording, or `None` when it is shorter than one.
+    fn new(a: &Analysis) -> Option<Self> {
+        let rate = a.sample_rate_hz;
+        let window_len = ((FRAME_S * rate).log2().round().exp2() as usize).max(64);
+        if a.signal.len() < window_len {
+            return None;
+        }
+        let hop = window_len / FRAMES_PER_WINDOW;
+        let recording = Spectrogram::new(&a.signal, rate, window_len, hop, PAD);
+        let window = hann(window_len);
+        let sum_sq = window.iter().map(|w| w * w).sum();
+        let time_s = (0..recording.power.len())
+            .map(|j| (j * hop) as f64 / rate + 0.5 * (window_len - 1) as f64 / rate)
+            .collect();
+        Some(Self {
+            recording,
+            window,
+            sum_sq,
+            hop,
+            time_s,
+        })
+    }
+}
+
 /// Corrects the gains and decays of `a`'s modes so each one's level over time follows the
 /// recording's near its frequency.
 pub fn match_levels(a: &mut Analysis, min_hz: f64, max_hz: f64) {
-    let rate = a.sample_rate_hz;
-    let window_len = ((FRAME_S * rate).log2().round().exp2() as usize).max(64);
-    if a.signal.len() < window_len {
+    let Some(frames) = Frames::new(a) else {
         return;
-    }
-    let hop = window_len / FRAMES_PER_WINDOW;
-    let recording = Spectrogram::new(&a.signal, rate, window_len, hop, PAD);
-    let window = hann(window_len);
-    let sum_sq: f64 = window.iter().map(|w| w * w).sum();
-    let frame_s: Vec<f64> = (0..recording.power.len())
-        .map(|j| (j * hop) as f64 / rate + 0.5 * (window_len - 1) as f64 / rate)
-        .collect();
-    let synthesis = synthesize(a, window_len, hop);
-    add_missing(a, &recording, &synthesis, &window, &frame_s, min_hz..max_hz);
+    };
+    let synthesis = synthesize(a, &frames);
+    add_missing(a, &frames, &synthesis, min_hz..max_hz);
     if a.modes.is_empty() {
         return;
     }
-    let groups = groups(a, &recording);
+    let groups = groups(a, &frames.recording);
     // Each group's recording power per frame, and the noise's.
     let measured: Vec<(Vec<f64>, f64)> = groups
         .iter()
         .map(|g| {
-            let noise =
-                a.noise_density(a.modes[g.modes.start].freq_hz) * sum_sq * g.bins.len() as f64;
-            let power = recording
+            let noise = a.noise_density(a.modes[g.modes.start].freq_hz)
+                * frames.sum_sq
+                * g.bins.len() as f64;
+            let power = frames
+                .recording
                 .power
                 .iter()
                 .map(|frame| frame[g.bins.clone()].iter().sum())
@@ -128,105 +160,143 @@ pub fn match_levels(a: &mut Analysis, min_hz: f64, max_hz: f64) {
         .collect();
     let mut total_db = vec![0.0; groups.len()];
     for _ in 0..ROUNDS {
-        let synthesis = synthesize(a, window_len, hop);
-        for ((g, (rec_power, noise)), total_db) in groups.iter().zip(&measured).zip(&mut total_db) {
-            // A group gone within a frame step is a click the frames cannot see: the band fit
-            // measured it.
-            let slowest = a.modes[g.modes.clone()]
-                .iter()
-                .map(|m| m.decay_per_s)
-                .fold(f64::INFINITY, f64::min);
-            if slowest * hop as f64 / rate > MAX_NEPERS_PER_HOP {
-                continue;
-            }
-            // The group's own spectrum in its bins, frame by frame: each mode's in the first
-            // frame, turned and shrunk by its pole from frame to frame (each frame starts at or
-            // after the onset). Summed as complex values, so modes that cancel or beat count as
-            // they sound.
-            let modes = &a.modes[g.modes.clone()];
-            let spectra: Vec<(Vec<Complex64>, Vec<Complex64>)> = modes
-                .iter()
-                .map(|m| own_spectrum(m, rate, &window, g.bins.clone(), recording.fft_len))
-                .collect();
-            let steps: Vec<Complex64> = modes
-                .iter()
-                .map(|m| pole(m, rate).powi(hop as i32))
-                .collect();
-            let mut turns = vec![Complex64::new(1.0, 0.0); modes.len()];
-            let mut bins = vec![Complex64::new(0.0, 0.0); g.bins.len()];
-            let mut points: Vec<(f64, f64)> = Vec::new();
-            for j in 0..synthesis.power.len() {
-                bins.fill(Complex64::new(0.0, 0.0));
-                for ((positive, negative), u) in spectra.iter().zip(&turns) {
-                    for ((b, p), n) in bins.iter_mut().zip(positive).zip(negative) {
-                        *b += u * p + u.conj() * n;
-                    }
-                }
-                for (u, step) in turns.iter_mut().zip(&steps) {
-                    *u *= step;
-                }
-                let own: f64 = bins.iter().map(|b| b.norm_sqr()).sum();
-                let total: f64 = synthesis.power[j][g.bins.clone()].iter().sum();
-                // What the recording holds beyond the other modes is the group's, in the frames
-                // it stands clear of the noise and the group rules the resynthesis.
-                let wanted = rec_power[j] - (total - own);
-                if wanted >= ABOVE_NOISE * noise && own >= MIN_SHARE * total && own > 0.0 {
-                    points.push((frame_s[j], 10.0 * (wanted / own).log10()));
-                }
-            }
-            let Some((at_onset_db, slope_db_per_s)) = line(&points) else {
-                continue;
-            };
-            let step_db = (*total_db + at_onset_db).clamp(-MAX_GAIN_DB, MAX_GAIN_DB) - *total_db;
-            *total_db += step_db;
-            let step = 10f64.powf(step_db / 20.0);
-            for m in &mut a.modes[g.modes.clone()] {
-                // The frames are mostly the tail, which the group's slow modes make: a quick
-                // mode beside them (the first stage of a decay fast then slow) keeps its level.
-                if m.decay_per_s > TAIL_SPREAD * slowest {
-                    continue;
-                }
-                m.amplitude *= step;
-                m.gain *= step;
-                // Power falling by s dB per second more is an amplitude decay s ln(10) / 20
-                // faster.
-                let wanted = m.decay_per_s - slope_db_per_s * std::f64::consts::LN_10 / 20.0;
-                m.decay_per_s = wanted
-                    .max(m.decay_per_s / MAX_DECAY_STEP)
-                    .max(MIN_DECAY_PER_S);
-                m.track.decay_per_s = m.decay_per_s;
-                m.track.amplitude = m.amplitude.norm();
-            }
+        let synthesis = synthesize(a, &frames);
+        for ((g, measured), total_db) in groups.iter().zip(&measured).zip(&mut total_db) {
+            correct_group(a, g, &frames, &synthesis, measured, total_db);
         }
     }
 }
 
-/// The spectrogram of `a`'s modes resynthesised.
-fn synthesize(a: &Analysis, window_len: usize, hop: usize) -> Spectrogram {
+/// One round's correction of the gains and decays of group `g`'s modes, from the recording's
+/// power in its bins per frame and the noise's there (`measured`) against the resynthesis
+/// `synthesis`; `total_db` is the gain correction of the rounds so far, kept within
+/// [`MAX_GAIN_DB`].
+fn correct_group(
+    a: &mut Analysis,
+    g: &Group,
+    frames: &Frames,
+    synthesis: &Spectrogram,
+    measured: &(Vec<f64>, f64),
+    total_db: &mut f64,
+) {
+    let rate = a.sample_rate_hz;
+    // A group gone within a frame step is a click the frames cannot see: the band fit
+    // measured it.
+    let slowest = a.modes[g.modes.clone()]
+        .iter()
+        .map(|m| m.decay_per_s)
+        .fold(f64::INFINITY, f64::min);
+    if slowest * frames.hop as f64 / rate > MAX_NEPERS_PER_HOP {
+        return;
+    }
+    let points = group_points(
+        &a.modes[g.modes.clone()],
+        rate,
+        g,
+        frames,
+        synthesis,
+        measured,
+    );
+    let Some((at_onset_db, slope_db_per_s)) = line(&points) else {
+        return;
+    };
+    let step_db = (*total_db + at_onset_db).clamp(-MAX_GAIN_DB, MAX_GAIN_DB) - *total_db;
+    *total_db += step_db;
+    let step = 10f64.powf(step_db / 20.0);
+    for m in &mut a.modes[g.modes.clone()] {
+        // The frames are mostly the tail, which the group's slow modes make: a quick
+        // mode beside them (the first stage of a decay fast then slow) keeps its level.
+        if m.decay_per_s > TAIL_SPREAD * slowest {
+            continue;
+        }
+        m.amplitude *= step;
+        m.gain *= step;
+        // Power falling by s dB per second more is an amplitude decay s ln(10) / 20
+        // faster.
+        let wanted = m.decay_per_s - slope_db_per_s * std::f64::consts::LN_10 / 20.0;
+        m.decay_per_s = wanted
+            .max(m.decay_per_s / MAX_DECAY_STEP)
+            .max(MIN_DECAY_PER_S);
+        m.track.decay_per_s = m.decay_per_s;
+        m.track.amplitude = m.amplitude.norm();
+    }
+}
+
+/// The frames that tell the level of group `g` (its modes `modes`): their times, and the
+/// recording's power in the group's bins beyond the other modes' over the group's own, in dB.
+/// A frame tells where that power stands clear of the noise and the group rules the
+/// resynthesis.
+///
+/// The group's own spectrum in its bins, frame by frame: each mode's in the first frame, turned
+/// and shrunk by its pole from frame to frame (each frame starts at or after the onset). Summed
+/// as complex values, so modes that cancel or beat count as they sound.
+fn group_points(
+    modes: &[Found],
+    rate: f64,
+    g: &Group,
+    frames: &Frames,
+    synthesis: &Spectrogram,
+    (rec_power, noise): &(Vec<f64>, f64),
+) -> Vec<(f64, f64)> {
+    let fft_len = frames.recording.fft_len;
+    let spectra: Vec<(Vec<Complex64>, Vec<Complex64>)> = modes
+        .iter()
+        .map(|m| own_spectrum(m, rate, &frames.window, g.bins.clone(), fft_len))
+        .collect();
+    let steps: Vec<Complex64> = modes
+        .iter()
+        .map(|m| pole(m, rate).powi(frames.hop as i32))
+        .collect();
+    let mut turns = vec![Complex64::new(1.0, 0.0); modes.len()];
+    let mut bins = vec![Complex64::new(0.0, 0.0); g.bins.len()];
+    let mut points: Vec<(f64, f64)> = Vec::new();
+    for ((frame, rec_power), time_s) in synthesis.power.iter().zip(rec_power).zip(&frames.time_s) {
+        bins.fill(Complex64::new(0.0, 0.0));
+        for ((positive, negative), u) in spectra.iter().zip(&turns) {
+            for ((b, p), n) in bins.iter_mut().zip(positive).zip(negative) {
+                *b += u * p + u.conj() * n;
+            }
+        }
+        for (u, step) in turns.iter_mut().zip(&steps) {
+            *u *= step;
+        }
+        let own: f64 = bins.iter().map(|b| b.norm_sqr()).sum();
+        let total: f64 = frame[g.bins.clone()].iter().sum();
+        let wanted = rec_power - (total - own);
+        if wanted >= ABOVE_NOISE * noise && own >= MIN_SHARE * total && own > 0.0 {
+            points.push((*time_s, 10.0 * (wanted / own).log10()));
+        }
+    }
+    points
+}
+
+/// The spectrogram of `a`'s modes resynthesised, in `frames`.
+fn synthesize(a: &Analysis, frames: &Frames) -> Spectrogram {
     let shapes = a.shapes();
     let amplitudes: Vec<Complex64> = a.modes.iter().map(|m| m.amplitude).collect();
     let mut model = vec![0.0; a.signal.len()];
     add_modes(&mut model, a.sample_rate_hz, &shapes, &amplitudes);
-    Spectrogram::new(&model, a.sample_rate_hz, window_len, hop, PAD)
+    Spectrogram::new(
+        &model,
+        a.sample_rate_hz,
+        frames.window.len(),
+        frames.hop,
+        PAD,
+    )
 }
 
 /// Gives a mode to each peak of the recording's spectrum (summed over the frames) that stands
 /// [`MISSING_ABOVE_NOISE`] over the noise and [`MISSING_ABOVE_MODEL`] over the resynthesis, with
-/// no mode within the frames' resolution: a partial the band fits left out. Its frequency is the
-/// peak's, its level and decay the line through its power over the frames (seed 000 section
-/// 6.2.2's measurement); one whose decay is too slow to measure is left out (see
-/// [`MIN_MISSING_NEPERS`]).
+/// no mode within the frames' resolution: a partial the band fits left out (see
+/// [`missing_mode`]).
 fn add_missing(
     a: &mut Analysis,
-    recording: &Spectrogram,
+    frames: &Frames,
     synthesis: &Spectrogram,
-    window: &[f64],
-    frame_s: &[f64],
     range_hz: std::ops::Range<f64>,
 ) {
-    let rate = a.sample_rate_hz;
-    let sum_sq: f64 = window.iter().map(|w| w * w).sum();
-    let frames = recording.power.len();
+    let recording = &frames.recording;
+    let count = recording.power.len();
     let bins = recording.num_bins();
     let total = |spec: &Spectrogram, k: usize| spec.power.iter().map(|f| f[k]).sum::<f64>();
     let rec: Vec<f64> = (0..bins).map(|k| total(recording, k)).collect();
@@ -234,11 +304,10 @@ fn add_missing(
     let loudest = rec.iter().copied().fold(0.0, f64::max);
     let reach = (RESOLUTION_BINS * recording.pad as f64).round() as usize;
     let resolution_hz = RESOLUTION_BINS * recording.bin_hz * recording.pad as f64;
-    let sound_s = a.signal.len() as f64 / rate;
     let mut added = Vec::new();
     for k in reach.max(1)..bins.saturating_sub(reach) {
         let f = k as f64 * recording.bin_hz;
-        let noise = a.noise_density(f) * sum_sq * frames as f64;
+        let noise = a.noise_density(f) * frames.sum_sq * count as f64;
         let peak = (k - reach..=k + reach).all(|i| rec[i] <= rec[k]);
         if !peak
             || !range_hz.contains(&f)
@@ -251,68 +320,92 @@ fn add_missing(
         {
             continue;
         }
-        // The peak between bins, from a parabola through the log powers.
-        let (l, c, r) = (rec[k - 1].ln(), rec[k].ln(), rec[k + 1].ln());
-        let denom = l - 2.0 * c + r;
-        let offset = if denom < 0.0 && denom.is_finite() {
-            (0.5 * (l - r) / denom).clamp(-0.5, 0.5)
-        } else {
-            0.0
-        };
-        let freq_hz = (k as f64 + offset) * recording.bin_hz;
-        let part = k - reach..k + reach + 1;
-        let frame_noise = noise / frames as f64 * (part.len() as f64);
-        // The recording's power there beyond the other modes', where it stands clear of the
-        // noise.
-        let points: Vec<(f64, f64)> = (0..frames)
-            .filter_map(|j| {
-                let p = recording.power[j][part.clone()].iter().sum::<f64>()
-                    - synthesis.power[j][part.clone()].iter().sum::<f64>();
-                (p >= ABOVE_NOISE * frame_noise).then(|| (frame_s[j], 10.0 * p.log10()))
-            })
-            .collect();
-        let Some((at_onset_db, slope_db_per_s)) = line(&points) else {
-            continue;
-        };
-        let decay_per_s = (-slope_db_per_s * std::f64::consts::LN_10 / 20.0).max(MIN_DECAY_PER_S);
-        if decay_per_s * sound_s < MIN_MISSING_NEPERS {
-            continue;
-        }
-        // A unit mode's power in the part sets the amplitude.
-        let unit = Found {
-            freq_hz,
-            decay_per_s,
-            amplitude: Complex64::new(0.0, -1.0),
-            gain: 1.0,
-            track: Track::default(),
-        };
-        let unit_power = own_power(&unit, rate, window, part, recording.fft_len);
-        if unit_power.is_nan() || unit_power <= 0.0 {
-            continue;
-        }
-        // Both at the first frame: the unit mode's power there is that of the frame, not of
-        // its onset.
-        let first_frame_db = at_onset_db + slope_db_per_s * frame_s[0];
-        let amplitude = (10f64.powf(first_frame_db / 10.0) / unit_power).sqrt();
-        added.push(Found {
-            amplitude: Complex64::new(0.0, -amplitude),
-            gain: amplitude,
-            track: Track {
-                freq_hz,
-                decay_per_s,
-                amplitude,
-                frames: points.len(),
-                rms_error_db: 0.0,
-                snr_db: 10.0 * (rec[k] / noise).log10(),
-            },
-            ..unit
-        });
+        added.extend(missing_mode(a, frames, synthesis, &rec, k, reach, noise));
     }
     if added.is_empty() {
         return;
     }
     a.modes.extend(added);
     a.modes.sort_by(|x, y| x.freq_hz.total_cmp(&y.freq_hz));
+}
+
+/// The mode of the recording's peak at bin `k` (`rec`: its power in each bin summed over the
+/// frames, `noise` the noise's there): its frequency the peak's, its level and decay the line
+/// through its power beyond the resynthesis in the bins within `reach` over the frames (seed 000
+/// section 6.2.2's measurement). `None` when no frame stands clear of the noise or its decay is
+/// too slow to measure (see [`MIN_MISSING_NEPERS`]).
+fn missing_mode(
+    a: &Analysis,
+    frames: &Frames,
+    synthesis: &Spectrogram,
+    rec: &[f64],
+    k: usize,
+    reach: usize,
+    noise: f64,
+) -> Option<Found> {
+    let recording = &frames.recording;
+    let count = recording.power.len();
+    // The peak between bins, from a parabola through the log powers.
+    let (l, c, r) = (rec[k - 1].ln(), rec[k].ln(), rec[k + 1].ln());
+    let denom = l - 2.0 * c + r;
+    let offset = if denom < 0.0 && denom.is_finite() {
+        (0.5 * (l - r) / denom).clamp(-0.5, 0.5)
+    } else {
+        0.0
+    };
+    let freq_hz = (k as f64 + offset) * recording.bin_hz;
+    let part = k - reach..k + reach + 1;
+    let frame_noise = noise / count as f64 * (part.len() as f64);
+    // The recording's power there beyond the other modes', where it stands clear of the
+    // noise.
+    let points: Vec<(f64, f64)> = (0..count)
+        .filter_map(|j| {
+            let p = recording.power[j][part.clone()].iter().sum::<f64>()
+                - synthesis.power[j][part.clone()].iter().sum::<f64>();
+            (p >= ABOVE_NOISE * frame_noise).then(|| (frames.time_s[j], 10.0 * p.log10()))
+        })
+        .collect();
+    let (at_onset_db, slope_db_per_s) = line(&points)?;
+    let decay_per_s = (-slope_db_per_s * std::f64::consts::LN_10 / 20.0).max(MIN_DECAY_PER_S);
+    let sound_s = a.signal.len() as f64 / a.sample_rate_hz;
+    if decay_per_s * sound_s < MIN_MISSING_NEPERS {
+        return None;
+    }
+    // A unit mode's power in the part sets the amplitude.
+    let unit = Found {
+        freq_hz,
+        decay_per_s,
+        amplitude: Complex64::new(0.0, -1.0),
+        gain: 1.0,
+        track: Track::default(),
+    };
+    let unit_power = own_power(
+        &unit,
+        a.sample_rate_hz,
+        &frames.window,
+        part,
+        recording.fft_len,
+    );
+    if unit_power.is_nan() || unit_power <= 0.0 {
+        return None;
+    }
+    // Both at the first frame: the unit mode's power there is that of the frame, not of
+    // its onset.
+    let first_frame_db = at_onset_db + slope_db_per_s * frames.time_s[0];
+    let amplitude = (10f64.powf(first_frame_db / 10.0) / unit_power).sqrt();
+    Some(Found {
+        amplitude: Complex64::new(0.0, -amplitude),
+        gain: amplitude,
+        track: Track {
+            freq_hz,
+            decay_per_s,
+            amplitude,
+            frames: points.len(),
+            rms_error_db: 0.0,
+            snr_db: 10.0 * (rec[k] / noise).log10(),
+        },
+        ..unit
+    })
 }
 
 /// Modes too close to tell apart in the frames compared, and the bins they are compared in.

@@ -186,7 +186,7 @@ fn still_falling(spec: &Spectrogram, half: usize) -> (Vec<bool>, Vec<f64>) {
 mod tests {
     use super::super::stft::{hann, Spectrogram};
     use super::*;
-    use crate::dsp::rng::Rng;
+    use crate::rng::Rng;
 
     /// Analysis window of the tests, in samples, at 48 kHz.
     const LEN: usize = 2048;

@@ -233,7 +233,7 @@ fn level_fall_db(x: &[f64], sample_rate_hz: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dsp::rng::Rng;
+    use crate::rng::Rng;
 
     fn strike_at(onset: usize, noise: f64) -> Vec<f64> {
         let rate = 48_000.0;

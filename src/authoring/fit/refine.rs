@@ -424,14 +424,30 @@ impl<'a> Target<'a> {
 
     /// `J^T W J` and `J^T W r` for the parameters of `fit`: [`PARAMS`] per mode, then `tau`.
     fn normal_equations(&self, fit: &Modes) -> (Vec<f64>, Vec<f64>) {
+        let dim = PARAMS * fit.modes.len() + 1;
+        let mut buffers = self.jacobian.borrow_mut();
+        let (jacobian, residual) = &mut *buffers;
+        self.weighted_jacobian(fit, jacobian, residual);
+        let products = products(jacobian, residual, dim);
+        let columns = dim + 1;
+        let mut normal = vec![0.0; dim * dim];
+        let mut gradient = vec![0.0; dim];
+        for a in 0..dim {
+            gradient[a] = products[a * columns + dim];
+            for b in 0..dim {
+                normal[a * dim + b] = products[a.min(b) * columns + a.max(b)];
+            }
+        }
+        (normal, gradient)
+    }
+
+    /// Writes the weighted Jacobian of `fit` by columns, and its weighted residual, each as
+    /// real parts then imaginary parts: `J^T W J` is then the real part of `J^H W J`.
+    fn weighted_jacobian(&self, fit: &Modes, jacobian: &mut Vec<f64>, residual: &mut Vec<f64>) {
         let modes = &fit.modes;
         let dim = PARAMS * modes.len() + 1;
         let (cols, d_tau) = self.columns(fit);
-        // The weighted Jacobian by columns and the weighted residual, real parts then imaginary
-        // parts: `J^T W J` is then the real part of `J^H W J`.
         let m = self.range.len();
-        let mut buffers = self.jacobian.borrow_mut();
-        let (jacobian, residual) = &mut *buffers;
         // Every entry is written below.
         jacobian.resize(dim * 2 * m, 0.0);
         residual.resize(2 * m, 0.0);
@@ -466,47 +482,6 @@ impl<'a> Target<'a> {
             }
         }
         put(dim - 1, &d_tau, 1.0);
-        // By stretches of rows short enough that every column's stretch stays in the cache
-        // while it meets the others, and by blocks of columns, each loaded once for several
-        // products. The residual is the last column: its products are the gradient.
-        let columns = dim + 1;
-        let mut products = vec![0.0; columns * columns];
-        for start in (0..2 * m).step_by(ROWS_AT_ONCE) {
-            let rows = start..(start + ROWS_AT_ONCE).min(2 * m);
-            let column = |a: usize| {
-                let a = a.min(columns - 1);
-                if a == dim {
-                    &residual[rows.clone()]
-                } else {
-                    &jacobian[a * 2 * m..(a + 1) * 2 * m][rows.clone()]
-                }
-            };
-            for a in (0..columns).step_by(BLOCK.0) {
-                for b in (a - a % BLOCK.1..columns).step_by(BLOCK.1) {
-                    let block = dots(
-                        std::array::from_fn(|i| column(a + i)),
-                        std::array::from_fn(|j| column(b + j)),
-                    );
-                    for (i, row) in block.iter().enumerate() {
-                        for (j, v) in row.iter().enumerate() {
-                            let (p, q) = (a + i, b + j);
-                            if p <= q && q < columns {
-                                products[p * columns + q] += v;
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        let mut normal = vec![0.0; dim * dim];
-        let mut gradient = vec![0.0; dim];
-        for a in 0..dim {
-            gradient[a] = products[a * columns + dim];
-            for b in 0..dim {
-                normal[a * dim + b] = products[a.min(b) * columns + a.max(b)];
-            }
-        }
-        (normal, gradient)
     }
 
     /// `fit` moved by the damped Gauss-Newton step.
@@ -652,6 +627,46 @@ impl<'a> Target<'a> {
     }
 }
 
+/// The upper triangle (row-major, `dim + 1` square) of the products of the `dim` columns of
+/// `jacobian` (one after another, each as long as `residual`) and `residual` (the last column:
+/// its products are the gradient).
+///
+/// By stretches of rows short enough that every column's stretch stays in the cache while it
+/// meets the others, and by blocks of columns, each loaded once for several products.
+fn products(jacobian: &[f64], residual: &[f64], dim: usize) -> Vec<f64> {
+    let rows_total = residual.len();
+    let columns = dim + 1;
+    let mut products = vec![0.0; columns * columns];
+    for start in (0..rows_total).step_by(ROWS_AT_ONCE) {
+        let rows = start..(start + ROWS_AT_ONCE).min(rows_total);
+        let column = |a: usize| {
+            let a = a.min(columns - 1);
+            if a == dim {
+                &residual[rows.clone()]
+            } else {
+                &jacobian[a * rows_total..(a + 1) * rows_total][rows.clone()]
+            }
+        };
+        for a in (0..columns).step_by(BLOCK.0) {
+            for b in (a - a % BLOCK.1..columns).step_by(BLOCK.1) {
+                let block = dots(
+                    std::array::from_fn(|i| column(a + i)),
+                    std::array::from_fn(|j| column(b + j)),
+                );
+                for (i, row) in block.iter().enumerate() {
+                    for (j, v) in row.iter().enumerate() {
+                        let (p, q) = (a + i, b + j);
+                        if p <= q && q < columns {
+                            products[p * columns + q] += v;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    products
+}
+
 /// The least-squares gains of the columns `subset` of the system `gram` (`rhs` its right-hand
 /// side, both over every column).
 fn subset_gains(gram: &[f64], rhs: &[f64], subset: &[usize]) -> Vec<f64> {
@@ -679,7 +694,7 @@ fn subset_gains(gram: &[f64], rhs: &[f64], subset: &[usize]) -> Vec<f64> {
 mod tests {
     use super::super::subband::{layout, split, Splitter};
     use super::*;
-    use crate::dsp::rng::Rng;
+    use crate::rng::Rng;
 
     /// Frequency in Hz, decay in 1/s and gain of each of three modes.
     const TRUTH: [(f64, f64, f64); 3] = [

@@ -251,7 +251,7 @@ mod tests {
 
     #[test]
     fn noise_alone_is_not_tracked() {
-        let mut rng = crate::dsp::rng::Rng::new(5);
+        let mut rng = crate::rng::Rng::new(5);
         let x: Vec<f64> = (0..48_000).map(|_| 1e-3 * rng.bipolar() as f64).collect();
         // Uniform noise in [-s, s] has variance s^2 / 3.
         let density = 1e-6 / 3.0;

@@ -1,4 +1,9 @@
 //! Reading surfaces: Wavefront OBJ and STL (ASCII and binary), and writing OBJ.
+//!
+//! Hand-written rather than `tobj` and `stl_io` for their errors: `tobj` names only a kind
+//! ("face parse error", "face vertex index out of bounds"), with no line, face or word; `stl_io`
+//! quotes the bad line of an ASCII STL but not its number, and a binary STL cut short is a bare
+//! end of file, without the triangles its header promised or the bytes it holds.
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
