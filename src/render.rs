@@ -7,6 +7,7 @@
 //! played to a plugin at the same samples give the same samples.
 
 mod midi_file;
+mod normalize;
 mod notes;
 mod wav;
 
@@ -15,6 +16,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 pub use midi_file::{read_midi_file, TimedMidi};
+pub use normalize::normalizing_scale;
 pub use notes::{parse_notes, Note};
 pub use wav::{to_int_sample, wav_bytes, write_wav, BitDepth, WavEncoder, WavFile};
 

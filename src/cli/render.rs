@@ -9,12 +9,11 @@ use std::sync::Arc;
 use clap::Args;
 
 use modal_resonator::bank::Bank;
-use modal_resonator::engine::{control_range, Controls, PositionMap, PreparedBank};
+use modal_resonator::engine::{Controls, PositionMap, PreparedBank};
 use modal_resonator::render::{
-    parse_notes, read_midi_file, render_to, wav_bytes, BitDepth, Note, RenderSettings,
-    RenderSummary, Rendered, Score, TimedMidi, WavFile,
+    normalizing_scale, parse_notes, read_midi_file, render_to, wav_bytes, BitDepth, Note,
+    RenderSettings, RenderSummary, Rendered, Score, TimedMidi, WavFile,
 };
-use modal_resonator::units::gain_to_db;
 
 use super::progress::Progress;
 use super::{check_output, load_bank, STDOUT};
@@ -173,7 +172,9 @@ fn render_output(
     let mut settings = settings.clone();
     let (scale, first_share) = match args.normalize {
         Some(peak_dbfs) => (
-            normalizing_scale(bank, score, &mut settings, peak_dbfs, progress),
+            normalizing_scale(bank, score, &mut settings, peak_dbfs, |d| {
+                progress.set(0.5 * d)
+            }),
             0.5,
         ),
         None => (1.0, 0.0),
@@ -198,48 +199,6 @@ fn render_output(
     .map_err(|e| e.to_string())?;
     file.finish().map_err(|e| e.to_string())?;
     Ok(rendered)
-}
-
-/// The gain that brings the render's peak to `peak_dbfs`, measured by rendering it (progress
-/// 0 to 0.5). Modes stop at the truncation threshold before the scaling: a render to be raised
-/// stops them as far lower in `settings` (down to the lowest threshold), or its tail would end
-/// in an audible cut; its peak is measured again with that threshold, since more modes start
-/// under it.
-fn normalizing_scale(
-    bank: &Arc<PreparedBank>,
-    score: Score,
-    settings: &mut RenderSettings,
-    peak_dbfs: f32,
-    progress: &mut Progress,
-) -> f32 {
-    let target = 10f32.powf(peak_dbfs / 20.0);
-    let mut peak_of = |settings: &RenderSettings, from: f64| {
-        let quiet = |_: &[f32], _: &[f32]| Ok::<(), Infallible>(());
-        let share = |d: f64| from + 0.25 * d;
-        let Ok(pass) = render_to(
-            bank,
-            score,
-            settings,
-            1.0,
-            |d| progress.set(share(d)),
-            quiet,
-        );
-        pass.peak
-    };
-    let mut peak = peak_of(settings, 0.0);
-    if peak > 0.0 && target > peak {
-        let lowest = control_range("truncation_db").0;
-        let lowered = (settings.controls.truncation_db - gain_to_db(target / peak)).max(lowest);
-        if lowered < settings.controls.truncation_db {
-            settings.controls.truncation_db = lowered;
-            peak = peak_of(settings, 0.25);
-        }
-    }
-    if peak > 0.0 {
-        target / peak
-    } else {
-        1.0
-    }
 }
 
 /// Renders the whole WAV in memory and writes it to standard output (a pipe cannot be

@@ -423,7 +423,7 @@ pub const VARIATION_GAIN_DB: f32 = 1.5;
 /// Fastest scrape, roll or rub, in m/s: a quick stroke of the hand.
 pub const CONTACT_SPEED_MAX_M_PER_S: f32 = CONTACT_SPEED_M_PER_S.max as f32;
 
-/// A model range as the `(min, max)` of a control.
+/// A bank format range as the `(min, max)` of a control.
 const fn span(range: NumberRange) -> (f32, f32) {
     (range.min as f32, range.max as f32)
 }

@@ -191,7 +191,7 @@ impl Voice {
             NoteExpression::Slide(s) if s.is_finite() => {
                 self.speed_m_per_s = Some(s.clamp(0.0, 1.0) * CONTACT_SPEED_MAX_M_PER_S)
             }
-            // Sanitised where the contact takes it ([`crate::dsp::contact::Contact::set_targets`]).
+            // Sanitised where the contact takes it ([`crate::dsp::contact::Contact::set_speed`]).
             NoteExpression::ContactSpeed(v) => self.speed_m_per_s = Some(v),
             _ => {}
         }
