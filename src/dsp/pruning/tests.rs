@@ -2,6 +2,7 @@
 
 use super::*;
 use crate::dsp::masking::{masking_curve_db, masking_threshold_db};
+use crate::rng::Rng;
 
 /// The seed's pseudo-code, literally: every pair, `O(N^2)`.
 fn reference(level: &[f32], bark: &[f32], threshold: &[f32], av: f32) -> Vec<bool> {
@@ -36,13 +37,8 @@ fn reference(level: &[f32], bark: &[f32], threshold: &[f32], av: f32) -> Vec<boo
 }
 
 fn random_scene(n: usize, seed: u32) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
-    let mut s = seed;
-    let mut rnd = move || {
-        s ^= s << 13;
-        s ^= s >> 17;
-        s ^= s << 5;
-        s as f32 / u32::MAX as f32
-    };
+    let mut rng = Rng::new(seed);
+    let mut rnd = move || rng.next_u32() as f32 / u32::MAX as f32;
     let level: Vec<f32> = (0..n).map(|_| 90.0 * rnd()).collect();
     let bark: Vec<f32> = (0..n).map(|_| 24.0 * rnd()).collect();
     let threshold: Vec<f32> = (0..n).map(|_| 10.0 * rnd()).collect();
@@ -268,13 +264,8 @@ fn both_paths_give_the_same_verdicts_maskers_and_envelopes() {
     // Three hundred modes spread over the Bark scale at scattered levels, after forty prior
     // maskers: many maskers per lane group, so a masked mode's masker is often past the first.
     let n = 300;
-    let mut seed = 0x2545_f491u32;
-    let mut next = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 17;
-        seed ^= seed << 5;
-        seed as f32 / u32::MAX as f32
-    };
+    let mut rng = Rng::new(0x2545_f491);
+    let mut next = move || rng.next_u32() as f32 / u32::MAX as f32;
     let prior_bark: Vec<f32> = (0..40).map(|_| 24.0 * next()).collect();
     let prior_level: Vec<f32> = (0..40).map(|_| 30.0 + 60.0 * next()).collect();
     let bark: Vec<f32> = (0..n).map(|_| 24.0 * next()).collect();
