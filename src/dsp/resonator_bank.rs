@@ -28,6 +28,7 @@ mod views;
 
 pub(crate) use dormant::floor;
 pub use dormant::FADE_DEPTH_NEPERS;
+pub use fades::NextTick;
 pub use strike::{Pulse, PulseShape};
 pub use views::{ActiveMode, DormantMode};
 

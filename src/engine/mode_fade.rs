@@ -2,7 +2,7 @@
 //! which start modes dormant, and by pruning, which switches them.
 
 use super::CONTROL_PERIOD;
-use crate::dsp::resonator_bank::floor;
+use crate::dsp::resonator_bank::{floor, NextTick};
 
 /// Shortest fade in or out, in seconds: short enough to follow the masking.
 const FADE_S: f64 = 0.005;
@@ -25,4 +25,14 @@ pub(in crate::engine) fn fade_samples(theta: f32, sample_rate_hz: f64) -> u32 {
     // Rounded up without `f64::ceil`, a library call on x86-64 without SSE4.1.
     let blocks = -floor(-samples / CONTROL_PERIOD as f64);
     blocks.max(1.0) as u32 * CONTROL_PERIOD as u32
+}
+
+/// Where the next control tick lies from engine clock `clock`: fades started between ticks are
+/// lengthened to end on one ([`NextTick`]).
+pub(in crate::engine) fn next_tick(clock: u64) -> NextTick {
+    let period = CONTROL_PERIOD as u64;
+    NextTick {
+        in_samples: ((period - clock % period) % period) as u32,
+        period: CONTROL_PERIOD as u32,
+    }
 }

@@ -1,5 +1,6 @@
 //! The audio-thread half of the engine: events, control ticks and rendering.
 
+use super::mode_fade::next_tick;
 use super::*;
 use crate::dsp::contact::{ContactKind, ContactMotion};
 use crate::dsp::masking::DB_PER_NEPER;
@@ -663,7 +664,7 @@ impl Engine {
         if heard {
             // Dormant modes cannot take input: compute them all again, in phase.
             if v.modes.num_dormant() + v.modes.num_fading() > 0 {
-                v.modes.wake_all();
+                v.modes.wake_all(next_tick(self.clock));
                 self.pruner.note_input();
             }
             v.modes

@@ -8,6 +8,33 @@
 use super::dormant::FADE_DEPTH_NEPERS;
 use super::{ResonatorBank, COLUMNS, GHOST, NONE};
 
+/// Where the next call of [`ResonatorBank::finish_fades`] (the next control tick) lies from now,
+/// for fades started between two: a fade ends only there, and a fade in running on past its end
+/// would grow its mode over the truth (by `FADE_DEPTH_NEPERS` per fade length) and then drop
+/// back, a click. Fades started now are lengthened to end on a tick.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct NextTick {
+    /// Samples from now to the next tick (0: now is a tick).
+    pub in_samples: u32,
+    /// Samples from one tick to the next.
+    pub period: u32,
+}
+
+impl NextTick {
+    /// Every sample is a tick: fades keep their lengths.
+    pub const EVERY_SAMPLE: Self = Self {
+        in_samples: 0,
+        period: 1,
+    };
+
+    /// The shortest length of at least `len` that ends on a tick.
+    pub fn fade_len(self, len: u64) -> u64 {
+        let period = self.period.max(1) as u64;
+        let to = self.in_samples as u64 % period;
+        len + (to + period - len % period) % period
+    }
+}
+
 impl ResonatorBank {
     /// Ends the fades due by now: modes faded out leave the rows, modes faded in become steady,
     /// ghosts join their modes.
@@ -75,20 +102,20 @@ impl ResonatorBank {
     /// (a dormant mode cannot take input): each computes the drive exactly from now on, and its
     /// old ringing fades back in beside it in a ghost slot, joining it in phase when the fade
     /// ends. A mode fading in or out continues its envelope from where it is.
-    pub fn wake_all(&mut self) {
+    pub fn wake_all(&mut self, tick: NextTick) {
         if self.num_dormant == 0 && self.num_fading == 0 {
             return;
         }
-        self.wake_fading();
+        self.wake_fading(tick);
         while self.num_dormant > 0 {
-            self.wake_record(self.num_dormant - 1);
+            self.wake_record(self.num_dormant - 1, tick);
         }
     }
 
     /// Wakes the modes fading in or out (through their poles they would take input wrongly):
     /// each computes from rest beside a ghost that carries its ringing on from where its
     /// envelope is.
-    pub fn wake_fading(&mut self) {
+    pub fn wake_fading(&mut self, tick: NextTick) {
         if self.num_fading == self.num_ghosts {
             return;
         }
@@ -128,10 +155,10 @@ impl ResonatorBank {
                 self.ghost_of_mode[mode] = slot as u32;
                 self.num_ghosts += 1;
                 self.gain[slot] = 0.0;
-                let len = len.max(1);
+                let len = tick.fade_len(len.max(1) as u64);
                 self.fade_delta[slot] = -depth / len as f64;
-                self.fade_end[slot] = now + len as u64;
-                self.next_fade_end = self.next_fade_end.min(now + len as u64);
+                self.fade_end[slot] = now + len;
+                self.next_fade_end = self.next_fade_end.min(now + len);
                 let fresh = self.push_slot(mode as u32, column);
                 (self.theta[fresh], self.delta[fresh]) = (theta, delta);
                 self.gain[fresh] = gain;
@@ -143,14 +170,14 @@ impl ResonatorBank {
     /// Wakes dormant `mode` (not one fading out; see [`ResonatorBank::wake_fading`]): it computes
     /// from rest beside a ghost that fades its ringing back in. A mode started from rest at this
     /// instant ([`ResonatorBank::start_dormant`]) has no ringing yet: it simply computes.
-    pub fn wake(&mut self, mode: usize) {
+    pub fn wake(&mut self, mode: usize, tick: NextTick) {
         let r = self.dormant_of_mode[mode];
         if r != NONE && self.slot_of_mode[mode] == NONE {
-            self.wake_record(r as usize);
+            self.wake_record(r as usize, tick);
         }
     }
 
-    pub(super) fn wake_record(&mut self, r: usize) {
+    pub(super) fn wake_record(&mut self, r: usize, tick: NextTick) {
         let now = self.clock;
         let mut d = self.take_record(r);
         let column = d.column as usize;
@@ -172,7 +199,7 @@ impl ResonatorBank {
         self.re[ghost] = re * start;
         self.im[ghost] = im * start;
         (self.theta[ghost], self.delta[ghost]) = (d.theta, d.delta);
-        let len = d.fade_len.max(1) as u64;
+        let len = tick.fade_len(d.fade_len.max(1) as u64);
         self.fade_delta[ghost] = -FADE_DEPTH_NEPERS / len as f64;
         self.fade_end[ghost] = now + len;
         self.next_fade_end = self.next_fade_end.min(now + len);

@@ -17,7 +17,7 @@
 //! computed through it (they soon die away).
 
 use super::dormant::Dormant;
-use super::ResonatorBank;
+use super::{NextTick, ResonatorBank};
 use crate::dsp::masking::power_to_db;
 use crate::dsp::prefetch::{self, prefetch};
 use realfft::num_complex::Complex64;
@@ -159,11 +159,12 @@ impl ResonatorBank {
     /// fast to take it analytically are woken at once. Returns how many took it. Call it for
     /// every pulse within which modes may start dormant, dormant modes or not: those started
     /// later take the rest of the pulses still playing
-    /// ([`ResonatorBank::num_pulses_under_way`]).
+    /// ([`ResonatorBank::num_pulses_under_way`]). Fades started now end on `tick`'s ticks.
     pub fn absorb_strike(
         &mut self,
         pulse: Pulse,
         due: bool,
+        tick: NextTick,
         mut gain_of: impl FnMut(usize) -> f32,
     ) -> usize {
         let under_way = self.note_pulse(pulse);
@@ -191,7 +192,7 @@ impl ResonatorBank {
         for k in (0..num_waking).rev() {
             let r = self.absorb.waking[k] as usize;
             let mode = self.dormant[r].mode as usize;
-            self.wake_record(r);
+            self.wake_record(r, tick);
             let slot = self.slot_of_mode[mode] as usize;
             self.gain[slot] = gain_of(mode);
         }

@@ -255,7 +255,7 @@ mod dormant {
                 .zip(&b)
                 .map(|(a, b)| a.iter().sum::<f32>() - b.iter().sum::<f32>()),
         );
-        pruned.wake_all();
+        pruned.wake_all(NextTick::EVERY_SAMPLE);
         assert_eq!(pruned.num_dormant(), 0);
         assert_eq!(pruned.num_active(), n);
         assert_eq!(pruned.num_woken(), n as u64 / 2 + 1);
@@ -360,6 +360,7 @@ mod strike {
                 len,
             },
             true,
+            NextTick::EVERY_SAMPLE,
             gain,
         );
         let mut pos = 0;
@@ -368,7 +369,7 @@ mod strike {
             bank.process(Kernel::Scalar, Some(&x[..wake_after]), &mut acc);
         }
         pos += wake_after;
-        pruned.wake_all();
+        pruned.wake_all(NextTick::EVERY_SAMPLE);
         // On in control periods, ending fades as the engine does.
         for bank in [&mut pruned, &mut reference] {
             for chunk in x[pos..].chunks(64) {
@@ -438,7 +439,7 @@ mod strike {
                     (TAU * f / RATE, (1.0 + 40.0 * (m % 3) as f64) / RATE)
                 });
             }
-            pruned.absorb_strike(mallet(0.7, len), true, gain);
+            pruned.absorb_strike(mallet(0.7, len), true, NextTick::EVERY_SAMPLE, gain);
             exciter.strike(StrikeKind::Mallet, 0.7, len);
             let mut x = vec![0.0; 320];
             exciter.render(&mut x);
@@ -448,7 +449,7 @@ mod strike {
             }
         }
         assert_eq!(pruned.num_dormant(), n / 2);
-        pruned.wake_all();
+        pruned.wake_all(NextTick::EVERY_SAMPLE);
         for bank in [&mut pruned, &mut reference] {
             for _ in 0..32 {
                 let mut acc = vec![[0.0; COLUMNS]; 64];
@@ -503,7 +504,7 @@ mod strike {
         }
         assert_eq!(pruned.num_dormant(), n / 2);
         let (first, second) = (mallet(0.7, 600), mallet(0.4, 300));
-        pruned.absorb_strike(first, true, gain);
+        pruned.absorb_strike(first, true, NextTick::EVERY_SAMPLE, gain);
         let mut exciter = Exciter::new(3);
         exciter.strike(StrikeKind::Mallet, first.amplitude, first.len);
         let mut x = vec![0.0; 2048];
@@ -528,12 +529,12 @@ mod strike {
             bank.set_gains_with(gain2);
             bank.set_poles_with(pole);
         }
-        pruned.absorb_strike(second, true, gain2);
+        pruned.absorb_strike(second, true, NextTick::EVERY_SAMPLE, gain2);
         for bank in [&mut pruned, &mut reference] {
             go(bank, pos, wake_at);
         }
         pos = wake_at;
-        pruned.wake_all();
+        pruned.wake_all(NextTick::EVERY_SAMPLE);
         while pruned.num_fading() > 0 {
             for bank in [&mut pruned, &mut reference] {
                 go(bank, pos, pos + 64);
@@ -571,7 +572,7 @@ mod strike {
             amplitude: 0.1,
             len: 1,
         };
-        assert_eq!(bank.absorb_strike(pulse, true, |_| 1.0), 1, "absorbed");
+        assert_eq!(bank.absorb_strike(pulse, true, NextTick::EVERY_SAMPLE, |_| 1.0), 1, "absorbed");
     }
 
     #[test]
@@ -618,7 +619,7 @@ mod strike {
         };
         let before = reference.state(0).unwrap();
         let pulse = mallet(0.7, 600);
-        assert_eq!(pruned.absorb_strike(pulse, true, |_| 0.5), 2);
+        assert_eq!(pruned.absorb_strike(pulse, true, NextTick::EVERY_SAMPLE, |_| 0.5), 2);
         let bound = before.0.hypot(before.1) + 0.5 * pulse.amplitude;
         let read = level(&mut pruned);
         assert!(
@@ -679,7 +680,7 @@ mod strike {
                 };
                 exciter.strike(StrikeKind::Mallet, pulse.amplitude, pulse.len);
                 reference.set_gains_with(|_| gain);
-                assert_eq!(pruned.absorb_strike(pulse, true, |_| gain), 1);
+                assert_eq!(pruned.absorb_strike(pulse, true, NextTick::EVERY_SAMPLE, |_| gain), 1);
                 pruned.set_recheck(0, u64::MAX / 2, 0);
                 let mut due = false;
                 pruned.for_each_dormant(pruned.clock() + 900, |_| due = true);
@@ -699,4 +700,22 @@ mod strike {
             "reads {lowest_margin} dB under the truth"
         );
     }
+}
+
+#[test]
+fn fades_started_between_ticks_are_lengthened_to_end_on_one() {
+    let tick = NextTick {
+        in_samples: 10,
+        period: 64,
+    };
+    assert_eq!(tick.fade_len(256), 266);
+    assert_eq!(tick.fade_len(250), 266);
+    assert_eq!(tick.fade_len(266), 266);
+    assert_eq!(tick.fade_len(267), 330);
+    let on_a_tick = NextTick {
+        in_samples: 0,
+        period: 64,
+    };
+    assert_eq!(on_a_tick.fade_len(256), 256);
+    assert_eq!(NextTick::EVERY_SAMPLE.fade_len(37), 37);
 }

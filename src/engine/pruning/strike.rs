@@ -29,6 +29,7 @@ use crate::dsp::masking::{power_to_db, DB_PER_NEPER};
 use crate::dsp::prefetch::{self, prefetch};
 use crate::dsp::resonator_bank::Pulse;
 use crate::dsp::ExciterKind;
+use crate::engine::mode_fade::next_tick;
 use crate::engine::voice::start_threshold;
 use crate::engine::voice::VoiceState;
 use crate::engine::Engine;
@@ -54,9 +55,11 @@ impl Engine {
             return;
         }
         let start = self.pruner.profiling.then(Instant::now);
+        let tick = next_tick(self.clock);
+        let modes = &mut self.voices[i].modes;
         match kind.pulse_shape() {
-            Some(_) => modes.wake_fading(),
-            None => modes.wake_all(),
+            Some(_) => modes.wake_fading(tick),
+            None => modes.wake_all(tick),
         }
         if let Some(start) = start {
             self.pruner.stats.strike_ns += start.elapsed().as_nanos() as u64;
@@ -83,11 +86,13 @@ impl Engine {
             len,
         };
         let gains = &self.strike_gains;
+        let tick = next_tick(self.clock);
         let modes = &mut self.voices[i].modes;
         // With pruning the modes are judged below; with a budget alone, ranked by energy;
         // otherwise the next analysis looks at them.
         let pruning = self.expressed.pruning;
-        self.pruner.stats.absorbed += modes.absorb_strike(pulse, !pruning, |m| gains[m]) as u64;
+        self.pruner.stats.absorbed +=
+            modes.absorb_strike(pulse, !pruning, tick, |m| gains[m]) as u64;
         if modes.num_dormant() > 0 {
             // Dormant modes are left whatever comes of it: the analyses must go on even if
             // pruning and the budget are turned off before the next one, to bring them back.
@@ -127,9 +132,10 @@ impl Engine {
             }
         });
         let n = self.best_within_budget(cap);
+        let tick = next_tick(self.clock);
         let Engine { pruner, voices, .. } = self;
         for &(_, mode) in &pruner.ranked[..n] {
-            voices[i].modes.wake(mode as usize);
+            voices[i].modes.wake(mode as usize, tick);
         }
     }
 
@@ -201,6 +207,7 @@ impl Engine {
             ..
         } = self;
         let now = *clock;
+        let tick = next_tick(now);
         let reading = Reading::new(calibration_db, *sample_rate_hz, cap.is_some());
         // A voice taking a new note (or retuned) since the last analysis is judged as what it is
         // now, not by what was worked out for the old one.
@@ -335,7 +342,7 @@ impl Engine {
             } else if cap.is_some() {
                 p.ranked.push((p.cands.energy_db[k], mode as u32));
             } else {
-                modes.wake(mode);
+                modes.wake(mode, tick);
             }
         }
         p.cands.clear();
@@ -347,7 +354,7 @@ impl Engine {
             let modes = &mut voices[i].modes;
             for (j, &(_, mode)) in p.ranked.iter().enumerate() {
                 if j < n {
-                    modes.wake(mode as usize);
+                    modes.wake(mode as usize, tick);
                 } else {
                     // Heard, but not within the budget now: the next analysis ranks it.
                     p.off[i * stride + mode as usize] = OffReason::BUDGET;
