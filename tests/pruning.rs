@@ -1026,7 +1026,9 @@ fn pruning_adds_no_click_at_control_ticks_after_strikes() {
     // and dropped them back there: 70 times the signal's high band.
     let mut worst = (0.0f32, 0.0f32, 0usize);
     for e in &events {
-        let NoteEvent::On { time, .. } = *e else { continue };
+        let NoteEvent::On { time, .. } = *e else {
+            continue;
+        };
         let from = time as usize + 48;
         let to = (time as usize + 2400).min(d.len() - 80);
         for tick in (from.next_multiple_of(CONTROL_PERIOD)..to).step_by(CONTROL_PERIOD) {

@@ -197,3 +197,38 @@ pub fn nmr(signal: [&[f32]; 2], diff: [&[f32]; 2], playback_db_spl: f64, offset_
         worst,
     }
 }
+
+/// Third difference: a steep high-pass (18 dB per octave), under which a step or a kink stands
+/// out of ringing modes.
+fn third_difference(x: &[f32]) -> Vec<f32> {
+    x.windows(4)
+        .map(|w| w[3] - 3.0 * w[2] + 3.0 * w[1] - w[0])
+        .collect()
+}
+
+/// The worst click of a pruned render: over the control ticks (every `period` samples) from 1 to
+/// 50 ms after each strike in `strikes`, where the difference's high band stands more than four
+/// times out of its neighbourhood, the largest ratio of the difference's high band there to the
+/// unpruned signal's own around it, and the sample of that tick. About 1 where none stands out
+/// of the signal; a click is many times more.
+pub fn worst_click(signal: &[f32], diff: &[f32], strikes: &[usize], period: usize) -> (f64, usize) {
+    let (d, f) = (third_difference(diff), third_difference(signal));
+    let abs_max = |x: &[f32]| x.iter().fold(0.0f32, |m, v| m.max(v.abs())) as f64;
+    let ms = (RATE_HZ * 1e-3) as usize;
+    let mut worst = (0.0, 0);
+    for &at in strikes {
+        let to = (at + 50 * ms).min(d.len().saturating_sub(period + 1));
+        let mut tick = (at + ms).next_multiple_of(period);
+        while tick < to {
+            let here = abs_max(&d[tick - 3..tick]);
+            let around =
+                abs_max(&d[tick - period..tick - 4]).max(abs_max(&d[tick + 1..tick + period]));
+            let own = abs_max(&f[tick - period..tick + period]).max(1e-30);
+            if here > 4.0 * around && here / own > worst.0 {
+                worst = (here / own, tick);
+            }
+            tick += period;
+        }
+    }
+    worst
+}

@@ -572,7 +572,11 @@ mod strike {
             amplitude: 0.1,
             len: 1,
         };
-        assert_eq!(bank.absorb_strike(pulse, true, NextTick::EVERY_SAMPLE, |_| 1.0), 1, "absorbed");
+        assert_eq!(
+            bank.absorb_strike(pulse, true, NextTick::EVERY_SAMPLE, |_| 1.0),
+            1,
+            "absorbed"
+        );
     }
 
     #[test]
@@ -619,7 +623,10 @@ mod strike {
         };
         let before = reference.state(0).unwrap();
         let pulse = mallet(0.7, 600);
-        assert_eq!(pruned.absorb_strike(pulse, true, NextTick::EVERY_SAMPLE, |_| 0.5), 2);
+        assert_eq!(
+            pruned.absorb_strike(pulse, true, NextTick::EVERY_SAMPLE, |_| 0.5),
+            2
+        );
         let bound = before.0.hypot(before.1) + 0.5 * pulse.amplitude;
         let read = level(&mut pruned);
         assert!(
@@ -680,7 +687,10 @@ mod strike {
                 };
                 exciter.strike(StrikeKind::Mallet, pulse.amplitude, pulse.len);
                 reference.set_gains_with(|_| gain);
-                assert_eq!(pruned.absorb_strike(pulse, true, NextTick::EVERY_SAMPLE, |_| gain), 1);
+                assert_eq!(
+                    pruned.absorb_strike(pulse, true, NextTick::EVERY_SAMPLE, |_| gain),
+                    1
+                );
                 pruned.set_recheck(0, u64::MAX / 2, 0);
                 let mut due = false;
                 pruned.for_each_dormant(pruned.clock() + 900, |_| due = true);
