@@ -1033,7 +1033,8 @@ fn pruning_adds_no_click_at_control_ticks_after_strikes() {
         let to = (time as usize + 2400).min(d.len() - 80);
         for tick in (from.next_multiple_of(CONTROL_PERIOD)..to).step_by(CONTROL_PERIOD) {
             let at = abs_max(&d[tick - 3..tick]);
-            let around = abs_max(&d[tick - 64..tick - 4]).max(abs_max(&d[tick + 1..tick + 64]));
+            // The neighbourhood up to the ticks on either side, not including them.
+            let around = abs_max(&d[tick - 64..tick - 4]).max(abs_max(&d[tick + 1..tick + 60]));
             let signal = abs_max(&f[tick - 64..tick + 64]);
             let stands_out = at / around.max(1e-12);
             // A tick where the difference outgrows the signal's own high band and stands out of

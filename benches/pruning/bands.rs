@@ -209,8 +209,8 @@ fn third_difference(x: &[f32]) -> Vec<f32> {
 /// The worst click of a pruned render: over the control ticks (every `period` samples) from 1 to
 /// 50 ms after each strike in `strikes`, where the difference's high band stands more than four
 /// times out of its neighbourhood, the largest ratio of the difference's high band there to the
-/// unpruned signal's own around it, and the sample of that tick. About 1 where none stands out
-/// of the signal; a click is many times more.
+/// unpruned signal's own around it, and the sample of that tick; 0 (at sample 0) where no tick
+/// stands out. A click is many times the signal's own.
 pub fn worst_click(signal: &[f32], diff: &[f32], strikes: &[usize], period: usize) -> (f64, usize) {
     let (d, f) = (third_difference(diff), third_difference(signal));
     let abs_max = |x: &[f32]| x.iter().fold(0.0f32, |m, v| m.max(v.abs())) as f64;
@@ -222,7 +222,7 @@ pub fn worst_click(signal: &[f32], diff: &[f32], strikes: &[usize], period: usiz
         while tick < to {
             let here = abs_max(&d[tick - 3..tick]);
             let around =
-                abs_max(&d[tick - period..tick - 4]).max(abs_max(&d[tick + 1..tick + period]));
+                abs_max(&d[tick - period..tick - 4]).max(abs_max(&d[tick + 1..tick + period - 4]));
             let own = abs_max(&f[tick - period..tick + period]).max(1e-30);
             if here > 4.0 * around && here / own > worst.0 {
                 worst = (here / own, tick);

@@ -58,8 +58,8 @@ impl ResonatorBank {
                     continue;
                 }
                 if fade < 0.0 {
-                    // A fade started between control ticks ends between them too: take back
-                    // the growth since, so the state is the truth exactly.
+                    // A fade that ended before this call (none does when its start was given the
+                    // right `NextTick`): take back the growth since, so the state is the truth.
                     let over = (now - self.fade_end[slot]) as f64;
                     let back = (fade * over).exp() as f32;
                     self.re[slot] *= back;

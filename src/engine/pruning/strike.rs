@@ -56,7 +56,6 @@ impl Engine {
         }
         let start = self.pruner.profiling.then(Instant::now);
         let tick = next_tick(self.clock);
-        let modes = &mut self.voices[i].modes;
         match kind.pulse_shape() {
             Some(_) => modes.wake_fading(tick),
             None => modes.wake_all(tick),
