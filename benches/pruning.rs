@@ -23,8 +23,9 @@
 //! `PRUNING_REPEATS` (timed renders per case, default 5, the cases taking turns; the fastest of
 //! each counts), `PRUNING_OFFSETS=2.5,5,20` (other masking offsets; the targets are read at
 //! 5 dB), `PRUNING_FRAME_MS` (another analysis frame), `PRUNING_SCENE=hail` or `dense` (one
-//! scene) and `PRUNING_ONLY=5` (pruned renders only, `PRUNING_REPEATS` of them, with every
-//! counter of the last, for profilers).
+//! scene), `PRUNING_ONLY=5` (pruned renders only, `PRUNING_REPEATS` of them, with every
+//! counter of the last, for profilers) and `PRUNING_WHERE=1` (where the frame-bands over the
+//! mask lie: by band, by time since a strike, and the worst frame band by band).
 
 use std::hint::black_box;
 use std::sync::Arc;
@@ -302,6 +303,9 @@ fn scene_report(
             click.0,
             click.1 as f64 / RATE_HZ
         );
+        if std::env::var("PRUNING_WHERE").is_ok() {
+            print_where(&m, &strikes);
+        }
         ratios.push((c.masking_offset_db, m, run, click.0));
     }
     println!();
@@ -324,6 +328,35 @@ fn scene_report(
         worst_band_db,
         click,
     })
+}
+
+/// Prints where the frame-bands over the mask lie: by critical band, by the time since the last
+/// strike, and the worst frame band by band.
+fn print_where(m: &Nmr, strikes: &[usize]) {
+    let frame = (bands::NMR_FRAME_S * RATE_HZ) as usize;
+    let (mut by_band, mut by_age) = ([0usize; 25], [0usize; 6]);
+    for &(start_s, b) in &m.over {
+        by_band[b] += 1;
+        let start = (start_s * RATE_HZ) as usize;
+        // Frames since the last strike before the frame's end (0: a strike within it).
+        let age = strikes
+            .iter()
+            .filter(|&&s| s < start + frame)
+            .max()
+            .map_or(5, |&s| start.saturating_sub(s) / frame);
+        by_age[age.min(5)] += 1;
+    }
+    println!("    over the mask by band: {by_band:?}");
+    println!(
+        "    by frames since the last strike (0: one within the frame; 5: five or more): {by_age:?}"
+    );
+    for (b, [signal, diff, mask, quiet]) in m.worst_frame.iter().enumerate() {
+        println!(
+            "    worst frame ({:.2} s), Bark {b:>2}: signal {signal:>6.1}, difference {diff:>6.1}, \
+             mask {mask:>6.1}, threshold in quiet {quiet:>6.1} dB SPL",
+            m.worst.2
+        );
+    }
 }
 
 /// Prints what each case's render measured, against the first (pruning off).

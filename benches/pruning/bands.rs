@@ -86,7 +86,7 @@ pub fn bark_to_hz(bark: f64) -> f64 {
 }
 
 /// Length of the frames the noise-to-mask ratio is measured over, in seconds.
-const NMR_FRAME_S: f64 = 0.02;
+pub const NMR_FRAME_S: f64 = 0.02;
 
 /// Noise-to-mask ratios of a difference signal against the masking threshold of the signal it
 /// was taken from, per 20 ms frame and critical band.
@@ -99,6 +99,11 @@ pub struct Nmr {
     pub p99_db: f64,
     /// The worst, in dB, its critical band and the time of its frame in seconds.
     pub worst: (f64, usize, f64),
+    /// The frame-bands over 0 dB: the frame's start in seconds, and the band.
+    pub over: Vec<(f64, usize)>,
+    /// The worst frame, band by band: signal, difference, masking curve and threshold in quiet,
+    /// in dB SPL.
+    pub worst_frame: Vec<[f64; 4]>,
 }
 
 /// Mean square of `x` (each channel's averaged) in each critical band, per frame of
@@ -166,21 +171,38 @@ pub fn nmr(signal: [&[f32]; 2], diff: [&[f32]; 2], playback_db_spl: f64, offset_
     let (s, d) = (frame_band_power(signal), frame_band_power(diff));
     let mut ratios = Vec::with_capacity(25 * s.len());
     let mut worst = (f64::NEG_INFINITY, 0, 0.0);
+    let (mut over, mut worst_frame) = (Vec::new(), Vec::new());
+    let curve = |s: &[f64; 25], b: usize| {
+        (0..25)
+            .filter(|&j| s[j] > 0.0)
+            .map(|j| {
+                masking_curve_db(
+                    j as f32 + 0.5,
+                    spl(s[j]) as f32,
+                    offset_db as f32,
+                    b as f32 + 0.5,
+                ) as f64
+            })
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
     for (f, (s, d)) in s.iter().zip(&d).enumerate() {
+        let start_s = f as f64 * 0.5 * NMR_FRAME_S;
+        let mut frame_worst = false;
         for b in 0..25 {
-            let probe = b as f32 + 0.5;
-            let curve = (0..25)
-                .filter(|&j| s[j] > 0.0)
-                .map(|j| {
-                    masking_curve_db(j as f32 + 0.5, spl(s[j]) as f32, offset_db as f32, probe)
-                        as f64
-                })
-                .fold(f64::NEG_INFINITY, f64::max);
-            let ratio = spl(d[b]) - curve.max(quiet[b]);
+            let ratio = spl(d[b]) - curve(s, b).max(quiet[b]);
+            if ratio > 0.0 {
+                over.push((start_s, b));
+            }
             if ratio > worst.0 {
-                worst = (ratio, b, f as f64 * 0.5 * NMR_FRAME_S);
+                worst = (ratio, b, start_s);
+                frame_worst = true;
             }
             ratios.push(ratio);
+        }
+        if frame_worst {
+            worst_frame = (0..25)
+                .map(|b| [spl(s[b]), spl(d[b]), curve(s, b), quiet[b]])
+                .collect();
         }
     }
     let cells = ratios.len();
@@ -195,6 +217,8 @@ pub fn nmr(signal: [&[f32]; 2], diff: [&[f32]; 2], playback_db_spl: f64, offset_
         share_ok: ok as f64 / cells.max(1) as f64,
         p99_db: p99,
         worst,
+        over,
+        worst_frame,
     }
 }
 
