@@ -335,8 +335,10 @@ fn scene_report(
 fn print_where(m: &Nmr, strikes: &[usize]) {
     let frame = (bands::NMR_FRAME_S * RATE_HZ) as usize;
     let (mut by_band, mut by_age) = ([0usize; 25], [0usize; 6]);
-    for &(start_s, b) in &m.over {
+    let mut louder = 0;
+    for &(start_s, b, over_signal_db) in &m.over {
         by_band[b] += 1;
+        louder += (over_signal_db > 0.0) as usize;
         let start = (start_s * RATE_HZ) as usize;
         // Frames since the last strike before the frame's end (0: a strike within it).
         let age = strikes
@@ -346,7 +348,11 @@ fn print_where(m: &Nmr, strikes: &[usize]) {
             .map_or(5, |&s| start.saturating_sub(s) / frame);
         by_age[age.min(5)] += 1;
     }
-    println!("    over the mask by band: {by_band:?}");
+    println!(
+        "    over the mask: {} frame-bands, {louder} of them with the difference louder than the \
+         signal (which cancels itself there); by band: {by_band:?}",
+        m.over.len()
+    );
     println!(
         "    by frames since the last strike (0: one within the frame; 5: five or more): {by_age:?}"
     );

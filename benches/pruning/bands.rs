@@ -99,8 +99,10 @@ pub struct Nmr {
     pub p99_db: f64,
     /// The worst, in dB, its critical band and the time of its frame in seconds.
     pub worst: (f64, usize, f64),
-    /// The frame-bands over 0 dB: the frame's start in seconds, and the band.
-    pub over: Vec<(f64, usize)>,
+    /// The frame-bands over 0 dB: the frame's start in seconds, the band, and the difference's
+    /// level over the signal's there in dB (above 0 only where the unpruned signal cancels
+    /// itself, as two modes of nearly one frequency in opposite phase do, and pruning took one).
+    pub over: Vec<(f64, usize, f64)>,
     /// The worst frame, band by band: signal, difference, masking curve and threshold in quiet,
     /// in dB SPL.
     pub worst_frame: Vec<[f64; 4]>,
@@ -191,7 +193,7 @@ pub fn nmr(signal: [&[f32]; 2], diff: [&[f32]; 2], playback_db_spl: f64, offset_
         for b in 0..25 {
             let ratio = spl(d[b]) - curve(s, b).max(quiet[b]);
             if ratio > 0.0 {
-                over.push((start_s, b));
+                over.push((start_s, b, spl(d[b]) - spl(s[b])));
             }
             if ratio > worst.0 {
                 worst = (ratio, b, start_s);
