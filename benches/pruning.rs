@@ -24,8 +24,10 @@
 //! each counts), `PRUNING_OFFSETS=2.5,5,20` (other masking offsets; the targets are read at
 //! 5 dB), `PRUNING_FRAME_MS` (another analysis frame), `PRUNING_SCENE=hail` or `dense` (one
 //! scene), `PRUNING_ONLY=5` (pruned renders only, `PRUNING_REPEATS` of them, with every
-//! counter of the last, for profilers) and `PRUNING_WHERE=1` (where the frame-bands over the
-//! mask lie: by band, by time since a strike, and the worst frame band by band).
+//! counter of the last, for profilers), `PRUNING_WHERE=1` (where the frame-bands over the
+//! mask lie: by band, by time since a strike, and the worst frame band by band) and
+//! `PRUNING_MASK_HOLD_MS=50` (the noise-to-mask ratio with each band's masker held at its highest
+//! over that long before, a crude forward masking; the targets are read without).
 
 use std::hint::black_box;
 use std::sync::Arc;

@@ -171,6 +171,7 @@ pub fn nmr(signal: [&[f32]; 2], diff: [&[f32]; 2], playback_db_spl: f64, offset_
         })
         .collect();
     let (s, d) = (frame_band_power(signal), frame_band_power(diff));
+    let s = hold_maskers(&s);
     let mut ratios = Vec::with_capacity(25 * s.len());
     let mut worst = (f64::NEG_INFINITY, 0, 0.0);
     let (mut over, mut worst_frame) = (Vec::new(), Vec::new());
@@ -222,6 +223,29 @@ pub fn nmr(signal: [&[f32]; 2], diff: [&[f32]; 2], playback_db_spl: f64, offset_
         over,
         worst_frame,
     }
+}
+
+/// The signal's band powers as maskers: with `PRUNING_MASK_HOLD_MS` (default 0, the measure as
+/// defined), each band's level is the highest over that many milliseconds of frames before and
+/// this one, a crude stand-in for forward masking (which in hearing lasts 100-200 ms). Without
+/// it, a frame where the unpruned signal dips (two modes of one band beating, a null between
+/// strikes) is judged as though nothing had sounded just before.
+fn hold_maskers(s: &[[f64; 25]]) -> Vec<[f64; 25]> {
+    let hold_ms: f64 = std::env::var("PRUNING_MASK_HOLD_MS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0.0);
+    let frames = (hold_ms * 1e-3 / (0.5 * NMR_FRAME_S)).round() as usize;
+    (0..s.len())
+        .map(|f| {
+            std::array::from_fn(|b| {
+                s[f.saturating_sub(frames)..=f]
+                    .iter()
+                    .map(|frame| frame[b])
+                    .fold(0.0, f64::max)
+            })
+        })
+        .collect()
 }
 
 /// Third difference: a steep high-pass (18 dB per octave), under which a step or a kink stands
