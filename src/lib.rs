@@ -15,6 +15,7 @@ pub mod params;
 pub mod plugin;
 pub mod render;
 pub mod rng;
+pub mod scene;
 pub mod units;
 
 pub use plugin::{ModalResonator, ModalResonatorFx};

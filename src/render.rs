@@ -191,14 +191,14 @@ impl std::error::Error for RenderError {
 
 /// A note event at an absolute sample time.
 #[derive(Debug, Clone, Copy)]
-struct TimedEvent {
+pub(crate) struct TimedEvent {
     /// Sample from the start of the render.
-    sample: u64,
+    pub(crate) sample: u64,
     /// Order among events on the same sample: releases of earlier notes, then strikes, then
     /// releases of notes struck on that very sample.
     rank: u8,
     /// The event, with its time set when its block is known.
-    event: NoteEvent,
+    pub(crate) event: NoteEvent,
 }
 
 /// What a render plays: notes (from `--notes`, with their contact curves), or a MIDI file's
@@ -290,7 +290,7 @@ fn schedule_midi(messages: &[TimedMidi], rate: f64, controls: &Controls) -> Vec<
 }
 
 /// The events of `notes` at `rate`, in the order the engine must see them.
-fn schedule(notes: &[Note], rate: f64, until_s: f64) -> Vec<TimedEvent> {
+pub(crate) fn schedule(notes: &[Note], rate: f64, until_s: f64) -> Vec<TimedEvent> {
     let to_sample = |t: f64| (t * rate).round().max(0.0) as u64;
     let mut events = Vec::with_capacity(2 * notes.len());
     for note in notes {

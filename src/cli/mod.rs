@@ -9,6 +9,7 @@ mod mesh;
 mod play;
 mod progress;
 mod render;
+mod scene;
 mod schema;
 mod shape;
 mod validate;
@@ -68,8 +69,15 @@ enum Command {
     },
     /// List the factory banks.
     List,
-    /// Print the JSON Schema of the bank format.
-    Schema,
+    /// Render a scene: objects placed in space, sounded by timed impacts and contacts, heard
+    /// from a listener's place.
+    Scene(scene::SceneArgs),
+    /// Print the JSON Schema of the bank format (of the scene format with --scene).
+    Schema {
+        /// The scene format's schema instead.
+        #[arg(long)]
+        scene: bool,
+    },
 }
 
 /// Parses the command line, runs the subcommand, and reports an error on stderr.
@@ -108,7 +116,8 @@ pub fn main() -> ExitCode {
         Some(Command::Validate { files }) => validate::run(&files).map(|()| ExitCode::SUCCESS),
         Some(Command::Info { bank }) => info::run(&bank).map(|()| ExitCode::SUCCESS),
         Some(Command::List) => list::run().map(|()| ExitCode::SUCCESS),
-        Some(Command::Schema) => schema::run().map(|()| ExitCode::SUCCESS),
+        Some(Command::Scene(args)) => scene::run(&args).map(|()| ExitCode::SUCCESS),
+        Some(Command::Schema { scene }) => schema::run(scene).map(|()| ExitCode::SUCCESS),
         Some(Command::Play { args }) => play::run(args).map(|()| ExitCode::SUCCESS),
         None => play::run(Vec::new()).map(|()| ExitCode::SUCCESS),
     };

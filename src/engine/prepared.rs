@@ -141,6 +141,22 @@ impl PreparedBank {
         prepared
     }
 
+    /// This bank with each mode's gains, at every position, multiplied by `gain(freq_hz)`, the
+    /// loudness normalisation kept: a filter on the object's modes, such as the air's absorption
+    /// over a distance (a scene's listener hears each object through one).
+    pub fn with_mode_gains(&self, gain: impl Fn(f64) -> f32) -> Self {
+        let mut out = self.clone();
+        let (n, k) = (self.num_modes(), self.num_positions);
+        for m in 0..n {
+            let g = gain(self.freq_hz[m]);
+            for p in 0..k {
+                out.gains[m * k + p] *= g;
+                out.gains_by_position[p * n + m] *= g;
+            }
+        }
+        out
+    }
+
     /// The order in which a prepared bank holds `bank`'s modes: `frequency_order(bank)[m]` is the
     /// index in `bank.modes` of prepared mode `m` (ascending frequency, ties in bank order).
     pub fn frequency_order(bank: &Bank) -> Vec<usize> {

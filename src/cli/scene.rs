@@ -1,0 +1,97 @@
+//! `modal-resonator scene`: a scene file rendered to a WAV file, heard from its listener.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+
+use modal_resonator::render::{BitDepth, WavFile};
+use modal_resonator::scene::{render_scene, SceneSource};
+
+use super::check_output;
+use super::progress::Progress;
+
+/// Arguments of `scene`.
+#[derive(Debug, Args)]
+pub(super) struct SceneArgs {
+    /// Scene file (JSON, "format": "modal-scene"); bank files it names are found relative to it.
+    scene: PathBuf,
+    /// WAV file to write.
+    #[arg(short, long, value_name = "FILE")]
+    output: PathBuf,
+    /// Sample rate in Hz.
+    #[arg(long, default_value_t = 48_000, value_parser = clap::value_parser!(u32).range(8_000..=384_000))]
+    rate: u32,
+    /// Bits per sample: 16 or 24 (integer) or 32 (float).
+    #[arg(long, default_value = "24", value_parser = parse_bit_depth)]
+    bits: BitDepth,
+    /// Longest render in seconds; the render stops earlier once everything is silent.
+    #[arg(long, default_value_t = 60.0)]
+    max_seconds: f64,
+}
+
+/// Parses `--bits`.
+fn parse_bit_depth(text: &str) -> Result<BitDepth, String> {
+    text.parse::<u16>()
+        .ok()
+        .and_then(BitDepth::from_bits)
+        .ok_or_else(|| format!("expected 16, 24 or 32, found \"{text}\""))
+}
+
+/// `scene`: the scene and every bank it names are read and checked before anything renders,
+/// and nothing is written on failure.
+pub(super) fn run(args: &SceneArgs) -> Result<(), String> {
+    if !(args.max_seconds > 0.0 && args.max_seconds <= 3600.0) {
+        return Err(format!(
+            "--max-seconds: expected over 0 up to 3600, found {}",
+            args.max_seconds
+        ));
+    }
+    check_output("-o", &args.output, &[("the scene", args.scene.as_path())])?;
+    let source = SceneSource::from_file(&args.scene).map_err(|e| e.to_string())?;
+    let started = Instant::now();
+    let mut progress = Progress::new("rendering");
+    let rendered = render_scene(&source, args.rate, args.max_seconds, |d| progress.set(d));
+    progress.finish();
+    let elapsed_s = started.elapsed().as_secs_f64();
+    let mut file =
+        WavFile::create(&args.output, args.bits, args.rate).map_err(|e| e.to_string())?;
+    file.write(&rendered.left, &rendered.right)
+        .map_err(|e| e.to_string())?;
+    file.finish().map_err(|e| e.to_string())?;
+    let seconds = rendered.left.len() as f64 / args.rate as f64;
+    let peak = rendered
+        .left
+        .iter()
+        .chain(&rendered.right)
+        .fold(0.0f32, |a, v| a.max(v.abs()));
+    let s = rendered.stats;
+    println!(
+        "{}: {seconds:.2} s, {} Hz {}, peak {:+.1} dBFS; {} object{}, {} impact{}, {} contact{}; \
+         rendered in {elapsed_s:.2} s ({:.1}x real time){}",
+        args.output.display(),
+        args.rate,
+        args.bits.name(),
+        20.0 * peak.max(1e-30).log10(),
+        s.objects,
+        if s.objects == 1 { "" } else { "s" },
+        s.impacts,
+        if s.impacts == 1 { "" } else { "s" },
+        s.contacts,
+        if s.contacts == 1 { "" } else { "s" },
+        seconds / elapsed_s.max(1e-9),
+        if rendered.cut_short {
+            ", cut at --max-seconds"
+        } else {
+            ""
+        },
+    );
+    if peak > 1.0 && args.bits != BitDepth::Float32 {
+        eprintln!(
+            "warning: the scene peaks over full scale and is clipped in the {} file: lower the \
+             objects' gain_db, or write --bits 32",
+            args.bits.name()
+        );
+    }
+    Ok(())
+}

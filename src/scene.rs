@@ -1,0 +1,414 @@
+//! Scenes: many objects, each a bank placed in space, sounded by timed impacts and contacts and
+//! heard from one listener's place (seed 001 sections 4-5, seed 003, seed 004).
+//!
+//! A scene file ([`format`]) names the objects, the events and the listener. Each object plays
+//! its bank through an engine of its own (two when it is both struck and scraped: the exciter is
+//! an engine's); the listener ([`listener`]) hears it through
+//!
+//! - a distance gain, `1/r` re 1 m, held at its value at [`listener::NEAR_M`] closer in;
+//! - the air's absorption over that distance (ISO 9613-1), a gain per mode, since it depends on
+//!   the frequency;
+//! - the time sound takes to arrive, and its direction: equal-power stereo by azimuth, or a
+//!   spherical head's two ears (Brown and Duda 1998: each ear's delay and head shadow).
+//!
+//! Objects and the listener stand still, so the arrival time shifts each object's events, whole
+//! samples, and only the fraction of a sample and the ears' difference pass through a delay
+//! line.
+//!
+//! An impact's loudness is proportional to its relative normal speed (seed 004 takes the
+//! impulse, `m u`): each object's strikes play at velocity `speed / s_ref` with a linear velocity
+//! curve and its output is scaled by `s_ref`, the fastest impact on it (at least 1 m/s), so an
+//! impact twice as fast is 6 dB louder wherever it falls. The velocity's effect on hardness is
+//! off unless the object's `set` turns it on (`velocity_to_hardness`).
+
+pub mod format;
+pub mod listener;
+mod object;
+
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+
+use crate::bank::factory::factory_bank;
+use crate::bank::validate::Problem;
+use crate::bank::{load_bank_file, Bank};
+use crate::engine::{Controls, ExciterKind, PreparedBank};
+use crate::render::{schedule, Note};
+use crate::units::db_to_gain;
+use format::{SceneError, SceneFile, SceneObject};
+use listener::{air_absorption_db_per_m, place};
+use object::SoundingObject;
+
+pub use format::{parse_scene_str, scene_schema_json, SCENE_FORMAT, SCENE_VERSION};
+
+/// Key every object's notes are played on: with key tracking off, any key plays the bank as
+/// authored.
+const KEY: u8 = 60;
+
+/// Slowest impact an object's levels are referred to, m/s: impacts at 1 m/s play at the bank's
+/// own level (and its `gain_db`).
+const REFERENCE_SPEED_M_PER_S: f64 = 1.0;
+
+/// Silence kept after the last sound, in seconds.
+pub const TAIL_S: f64 = 0.1;
+
+/// A scene with its banks, read and checked, not yet prepared to play.
+#[derive(Debug, Clone)]
+pub struct SceneSource {
+    /// The scene.
+    pub file: SceneFile,
+    /// The banks, one per distinct `bank` of the objects.
+    banks: Vec<Bank>,
+    /// Index into `banks` of each object's bank.
+    bank_of: Vec<usize>,
+}
+
+impl SceneSource {
+    /// A scene read from `path`, its bank files found relative to the scene's folder.
+    pub fn from_file(path: &Path) -> Result<Self, SceneError> {
+        let origin = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+            origin: origin.clone(),
+            problems: vec![Problem {
+                path: String::new(),
+                message: format!("cannot read the scene: {e}"),
+            }],
+        })?;
+        let file = parse_scene_str(&text, &origin)?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        Self::new(file, &origin, |spec| resolve_bank(spec, dir))
+    }
+
+    /// `file` with each object's bank from `resolve` (given the object's `bank`); `origin` names
+    /// the scene in errors.
+    pub fn new(
+        file: SceneFile,
+        origin: &str,
+        mut resolve: impl FnMut(&str) -> Result<Bank, String>,
+    ) -> Result<Self, SceneError> {
+        let mut banks = Vec::new();
+        let mut index: HashMap<&str, usize> = HashMap::new();
+        let mut bank_of = Vec::with_capacity(file.objects.len());
+        let mut problems = Vec::new();
+        for (i, o) in file.objects.iter().enumerate() {
+            if let Some(&k) = index.get(o.bank.as_str()) {
+                bank_of.push(k);
+                continue;
+            }
+            match resolve(&o.bank) {
+                Ok(bank) => {
+                    index.insert(&o.bank, banks.len());
+                    bank_of.push(banks.len());
+                    banks.push(bank);
+                }
+                Err(message) => {
+                    problems.push(Problem {
+                        path: format!("objects[{i}].bank"),
+                        message,
+                    });
+                    bank_of.push(usize::MAX);
+                }
+            }
+        }
+        if !problems.is_empty() {
+            return Err(SceneError {
+                origin: origin.to_string(),
+                problems,
+            });
+        }
+        let source = Self {
+            file,
+            banks,
+            bank_of,
+        };
+        // Controls are checked now, not when the scene is played.
+        for (i, o) in source.file.objects.iter().enumerate() {
+            source
+                .controls(o, &source.banks[source.bank_of[i]])
+                .map_err(|(name, message)| SceneError {
+                    origin: origin.to_string(),
+                    problems: vec![Problem {
+                        path: format!("objects[{i}].set.{name}"),
+                        message,
+                    }],
+                })?;
+        }
+        Ok(source)
+    }
+
+    /// The object's controls: the bank's defaults, the scene's (key tracking and the velocity's
+    /// hardness off, a linear velocity curve, width 0, the scale as the size), then its `set`.
+    fn controls(&self, o: &SceneObject, bank: &Bank) -> Result<Controls, (String, String)> {
+        let mut c = Controls::for_bank(bank);
+        c.key_tracking = 0.0;
+        c.velocity_sensitivity = 0.5;
+        c.velocity_to_hardness = 0.0;
+        c.width = 0.0;
+        c.size_ratio = o.scale as f32;
+        for (name, value) in &o.set {
+            c.set_by_name(name, value).map_err(|e| (name.clone(), e))?;
+        }
+        Ok(c)
+    }
+}
+
+/// A bank named in a scene: a factory bank's name (no folder, no extension), else a file,
+/// relative to `dir`.
+fn resolve_bank(spec: &str, dir: &Path) -> Result<Bank, String> {
+    let path = Path::new(spec);
+    let bare = path.components().count() == 1 && path.extension().is_none();
+    if bare {
+        if let Some(bank) = factory_bank(spec) {
+            return Ok(bank);
+        }
+    }
+    let file = dir.join(path);
+    if !file.exists() {
+        return Err(if bare {
+            format!(
+                "no factory bank named \"{spec}\" and no file {} (`modal-resonator list` shows \
+                 the factory banks)",
+                file.display()
+            )
+        } else {
+            format!("no bank file {}", file.display())
+        });
+    }
+    load_bank_file(&file).map_err(|e| e.to_string())
+}
+
+/// What a scene holds and did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct SceneStats {
+    /// Objects.
+    pub objects: usize,
+    /// Impacts.
+    pub impacts: usize,
+    /// Contacts.
+    pub contacts: usize,
+}
+
+/// A scene prepared to play: step it with [`Scene::process`]. Building allocates; processing
+/// does not, once a block has held as many events as it ever will.
+pub struct Scene {
+    /// The objects.
+    objects: Vec<SoundingObject>,
+    /// Sample at the listener of the next block's start.
+    clock: u64,
+    /// Largest block.
+    max_block: usize,
+    /// The sample at the listener of the last event.
+    last_event: u64,
+    /// Counts.
+    stats: SceneStats,
+}
+
+impl Scene {
+    /// Prepares `source` to play at `sample_rate_hz` in blocks of at most `max_block` samples.
+    pub fn new(source: &SceneSource, sample_rate_hz: u32, max_block: usize) -> Self {
+        let rate = sample_rate_hz as f64;
+        let prepared: Vec<Arc<PreparedBank>> = source
+            .banks
+            .iter()
+            .map(|b| Arc::new(PreparedBank::new(b)))
+            .collect();
+        let file = &source.file;
+        let mut by_object: Vec<Vec<&format::SceneEvent>> = vec![Vec::new(); file.objects.len()];
+        let index: HashMap<&str, usize> = file
+            .objects
+            .iter()
+            .enumerate()
+            .map(|(i, o)| (o.name.as_str(), i))
+            .collect();
+        for e in &file.events {
+            by_object[index[e.object.as_str()]].push(e);
+        }
+        let mut stats = SceneStats {
+            objects: file.objects.len(),
+            ..SceneStats::default()
+        };
+        let objects: Vec<SoundingObject> = file
+            .objects
+            .iter()
+            .enumerate()
+            .map(|(i, o)| {
+                let bank = &source.banks[source.bank_of[i]];
+                let controls = source
+                    .controls(o, bank)
+                    .expect("controls were checked when the scene was read");
+                let placement = place(&file.listener, o.position);
+                let r = placement.distance_m;
+                let scale = o.scale;
+                // The air's absorption over the distance, at each mode's frequency as played.
+                let heard = prepared[source.bank_of[i]].with_mode_gains(|f| {
+                    db_to_gain((-air_absorption_db_per_m(f / scale) * r) as f32)
+                });
+                let events = &by_object[i];
+                let fastest = events
+                    .iter()
+                    .filter_map(|e| e.impact.map(|x| x.speed_m_per_s))
+                    .fold(REFERENCE_SPEED_M_PER_S, f64::max);
+                let parts = parts(&controls, events, fastest, rate, &mut stats);
+                let gain = fastest / REFERENCE_SPEED_M_PER_S * db_to_gain(o.gain_db as f32) as f64;
+                SoundingObject::new(&Arc::new(heard), parts, &placement, gain, rate, max_block)
+            })
+            .collect();
+        let last_event = objects
+            .iter()
+            .filter_map(SoundingObject::last_event_sample)
+            .max()
+            .unwrap_or(0);
+        Self {
+            objects,
+            clock: 0,
+            max_block,
+            last_event,
+            stats,
+        }
+    }
+
+    /// The next `left.len()` samples at the listener (at most the block size given to
+    /// [`Scene::new`]), written to `left` and `right`.
+    pub fn process(&mut self, left: &mut [f32], right: &mut [f32]) {
+        assert!(left.len() <= self.max_block && left.len() == right.len());
+        left.fill(0.0);
+        right.fill(0.0);
+        for o in &mut self.objects {
+            o.add_to(self.clock, left, right);
+        }
+        self.clock += left.len() as u64;
+    }
+
+    /// Whether every event has been played and everything has fallen silent.
+    pub fn is_done(&self) -> bool {
+        self.objects.iter().all(SoundingObject::is_done)
+    }
+
+    /// The sample at the listener where the last event begins to be heard.
+    pub fn last_event_sample(&self) -> u64 {
+        self.last_event
+    }
+
+    /// What the scene holds.
+    pub fn stats(&self) -> SceneStats {
+        self.stats
+    }
+}
+
+/// An object's parts: an engine for its impacts and one for its contacts, each with its events
+/// as notes scheduled at `rate` (impacts at velocity `speed / fastest`, contacts at `1 /
+/// fastest`, as the object's output is scaled by `fastest`).
+fn parts(
+    controls: &Controls,
+    events: &[&format::SceneEvent],
+    fastest: f64,
+    rate: f64,
+    stats: &mut SceneStats,
+) -> Vec<(Controls, Vec<crate::render::TimedEvent>)> {
+    let mut strikes = Vec::new();
+    let mut contacts = Vec::new();
+    for e in events {
+        if let Some(impact) = e.impact {
+            strikes.push(Note::new(
+                KEY,
+                (impact.speed_m_per_s / fastest) as f32,
+                e.time_s,
+                None,
+            ));
+        }
+        if let Some(c) = e.contact {
+            contacts.push(Note {
+                key: KEY,
+                velocity: (1.0 / fastest) as f32,
+                time_s: e.time_s,
+                duration_s: Some(c.duration_s),
+                speed_m_per_s: Some((c.speed_m_per_s[0], c.speed_m_per_s[1])),
+                force: Some((c.force[0], c.force[1])),
+            });
+        }
+    }
+    stats.impacts += strikes.len();
+    stats.contacts += contacts.len();
+    let mut out = Vec::new();
+    let until_s = f64::INFINITY;
+    if !strikes.is_empty() {
+        let mut c = controls.clone();
+        if c.exciter.is_contact() {
+            c.exciter = ExciterKind::Mallet;
+        }
+        out.push((c, schedule(&strikes, rate, until_s)));
+    }
+    if !contacts.is_empty() {
+        let mut c = controls.clone();
+        if !c.exciter.is_contact() {
+            c.exciter = ExciterKind::Scrape;
+        }
+        out.push((c, schedule(&contacts, rate, until_s)));
+    }
+    out
+}
+
+/// What [`render_scene`] made.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderedScene {
+    /// Left channel.
+    pub left: Vec<f32>,
+    /// Right channel.
+    pub right: Vec<f32>,
+    /// Whether `max_seconds` cut it while it still sounded.
+    pub cut_short: bool,
+    /// What the scene held.
+    pub stats: SceneStats,
+}
+
+/// Renders `source` at `sample_rate_hz` into memory, up to `max_seconds` (faded over the last
+/// 10 ms if it still sounds there), [`TAIL_S`] of silence kept after the last sound;
+/// `progress` hears the share done (an estimate until the end).
+pub fn render_scene(
+    source: &SceneSource,
+    sample_rate_hz: u32,
+    max_seconds: f64,
+    mut progress: impl FnMut(f64),
+) -> RenderedScene {
+    const BLOCK: usize = 256;
+    let rate = sample_rate_hz as f64;
+    let max_samples = (max_seconds.max(0.0) * rate).round() as usize;
+    let mut scene = Scene::new(source, sample_rate_hz, BLOCK);
+    let (mut left, mut right) = (Vec::new(), Vec::new());
+    let (mut l, mut r) = (vec![0.0f32; BLOCK], vec![0.0f32; BLOCK]);
+    let mut last_sound = 0usize;
+    let estimate = (scene.last_event_sample() as f64 + 2.0 * rate).min(max_samples as f64);
+    while left.len() < max_samples && !(scene.is_done() && left.len() as u64 > scene.last_event) {
+        let n = BLOCK.min(max_samples - left.len());
+        scene.process(&mut l[..n], &mut r[..n]);
+        if let Some(k) = (0..n).rev().find(|&k| l[k] != 0.0 || r[k] != 0.0) {
+            last_sound = left.len() + k + 1;
+        }
+        left.extend_from_slice(&l[..n]);
+        right.extend_from_slice(&r[..n]);
+        progress((left.len() as f64 / estimate.max(1.0)).min(0.99));
+    }
+    let cut_short = !scene.is_done();
+    if cut_short {
+        let fade = ((0.01 * rate) as usize).min(left.len());
+        let start = left.len() - fade;
+        for k in 0..fade {
+            let g = 1.0 - (k + 1) as f32 / fade as f32;
+            left[start + k] *= g;
+            right[start + k] *= g;
+        }
+    } else {
+        // Silent from `last_sound` on: cut there, or padded with silence, to the tail's end.
+        let heard_to = last_sound.max(scene.last_event_sample() as usize + 1);
+        let end = (heard_to + (TAIL_S * rate) as usize).min(max_samples);
+        left.resize(end, 0.0);
+        right.resize(end, 0.0);
+    }
+    progress(1.0);
+    RenderedScene {
+        left,
+        right,
+        cut_short,
+        stats: scene.stats(),
+    }
+}

@@ -1,0 +1,401 @@
+//! Scenes: objects placed in space, sounded by timed events, heard from a listener's place.
+//! Levels against the laws the docs give (1/r, an impact's loudness proportional to its speed),
+//! arrival times against the speed of sound, the spherical head's interaural delay, and the
+//! scene file's errors.
+
+use std::fs;
+use std::path::Path;
+use std::process::Command;
+
+use modal_resonator::scene::format::MAX_OBJECTS;
+use modal_resonator::scene::listener::SPEED_OF_SOUND_M_PER_S;
+use modal_resonator::scene::{parse_scene_str, render_scene, scene_schema_json, SceneSource};
+
+const RATE: u32 = 48_000;
+
+/// A scene of `objects` (JSON objects) and `events`, heard in `output` from the origin facing -z.
+fn scene_json(objects: &str, events: &str, output: &str) -> String {
+    format!(
+        r#"{{"format": "modal-scene", "version": 1, "name": "test",
+            "objects": [{objects}], "events": [{events}],
+            "listener": {{"position": [0, 0, 0], "forward": [0, 0, -1], "output": "{output}"}}}}"#
+    )
+}
+
+/// Renders scene text whose banks are factory banks.
+fn render(text: &str) -> (Vec<f32>, Vec<f32>) {
+    let file = parse_scene_str(text, "test").unwrap_or_else(|e| panic!("{e}"));
+    let source = SceneSource::new(file, "test", |spec| {
+        modal_resonator::bank::factory::factory_bank(spec).ok_or_else(|| format!("no {spec}"))
+    })
+    .unwrap_or_else(|e| panic!("{e}"));
+    let r = render_scene(&source, RATE, 60.0, |_| {});
+    assert!(!r.cut_short);
+    (r.left, r.right)
+}
+
+fn rms(x: &[f32]) -> f64 {
+    (x.iter().map(|&v| (v as f64).powi(2)).sum::<f64>() / x.len().max(1) as f64).sqrt()
+}
+
+fn db(ratio: f64) -> f64 {
+    20.0 * ratio.log10()
+}
+
+/// First sample above `threshold` times the peak.
+fn onset(x: &[f32], threshold: f32) -> usize {
+    let peak = x.iter().fold(0.0f32, |a, v| a.max(v.abs()));
+    x.iter().position(|v| v.abs() > threshold * peak).unwrap()
+}
+
+const BAR: &str = "steel-free-free-bar";
+
+#[test]
+fn a_source_twice_as_far_is_6_db_quieter() {
+    let at = |z: f64| {
+        let objects = format!(r#"{{"name": "o", "bank": "{BAR}", "position": [0, 0, {z}]}}"#);
+        let events = r#"{"time_s": 0, "object": "o", "impact": {"speed_m_per_s": 1}}"#;
+        render(&scene_json(&objects, events, "stereo"))
+    };
+    let (near, _) = at(-2.0);
+    let (far, _) = at(-4.0);
+    // The air's absorption over 2 m more takes a little of the highs too (0.2 dB at 8 kHz).
+    let fall = db(rms(&near) / rms(&far));
+    assert!(
+        (fall - 6.02).abs() < 0.5,
+        "twice as far: {fall:.2} dB quieter"
+    );
+    // And 2 m more of travel: 5.8 ms later.
+    let late = onset(&far, 1e-3) as f64 - onset(&near, 1e-3) as f64;
+    let expected = 2.0 / SPEED_OF_SOUND_M_PER_S * RATE as f64;
+    assert!(
+        (late - expected).abs() <= 2.0,
+        "{late} samples later, expected {expected:.1}"
+    );
+}
+
+#[test]
+fn an_impact_twice_as_fast_is_6_db_louder() {
+    // One object, struck at 2 m/s and, once that has died away, at 1 m/s.
+    let objects = r#"{"name": "o", "bank": "acrylic-plate", "position": [0, 0, -1]}"#;
+    let events = r#"{"time_s": 0, "object": "o", "impact": {"speed_m_per_s": 2}},
+                    {"time_s": 2, "object": "o", "impact": {"speed_m_per_s": 1}}"#;
+    let (left, _) = render(&scene_json(objects, events, "stereo"));
+    let second = 2 * RATE as usize;
+    let peak = |x: &[f32]| x.iter().fold(0.0f32, |a, v| a.max(v.abs())) as f64;
+    let (fast, slow) = (&left[..RATE as usize], &left[second..]);
+    // What is left of the first when the second comes.
+    assert!(peak(&left[second - 480..second]) < 1e-3 * peak(fast));
+    let louder = db(peak(fast) / peak(slow));
+    assert!(
+        (louder - 6.02).abs() < 1.0,
+        "twice as fast: {louder:.2} dB louder"
+    );
+}
+
+#[test]
+fn stereo_places_a_source_by_its_azimuth() {
+    let events = r#"{"time_s": 0, "object": "o", "impact": {"speed_m_per_s": 1}}"#;
+    let at = |x: f64, z: f64| {
+        let objects = format!(r#"{{"name": "o", "bank": "{BAR}", "position": [{x}, 0, {z}]}}"#);
+        let (l, r) = render(&scene_json(&objects, events, "stereo"));
+        db(rms(&l) / rms(&r))
+    };
+    assert!(at(-2.0, 0.0) > 60.0, "hard left");
+    assert!(at(2.0, 0.0) < -60.0, "hard right");
+    assert!(at(0.0, -2.0).abs() < 0.01, "ahead");
+    // 45° to the left: the pan is halfway to the left, sin(3 pi / 8) over cos(3 pi / 8), 7.7 dB.
+    let half = at(-1.0, -1.0);
+    assert!((half - 7.66).abs() < 0.05, "45° left: {half:.2} dB");
+}
+
+#[test]
+fn binaurally_a_source_at_the_left_reaches_the_left_ear_first() {
+    // A plate of many modes struck by an impulse: broadband, so the correlation has one peak.
+    let objects = r#"{"name": "o", "bank": "acrylic-plate", "position": [-2, 0, 0],
+        "set": {"exciter": "impulse"}}"#;
+    let events = r#"{"time_s": 0, "object": "o", "impact": {"speed_m_per_s": 1}}"#;
+    let (l, r) = render(&scene_json(objects, events, "binaural"));
+    // The lag of the right ear: the peak of the cross-correlation over the first 10 ms, of the
+    // second differences (the highs: at low frequencies the head shadow's phase adds to the
+    // delay, as on a real head, 3a/c against 2a/c at the side; Kuhn 1977).
+    let n = (0.01 * RATE as f64) as usize;
+    let start = onset(&l, 1e-3).saturating_sub(64);
+    let highs = |x: &[f32]| -> Vec<f64> {
+        x.windows(3)
+            .map(|w| w[2] as f64 - 2.0 * w[1] as f64 + w[0] as f64)
+            .collect()
+    };
+    let (hl, hr) = (
+        highs(&l[start..start + n + 2]),
+        highs(&r[start..start + n + 2]),
+    );
+    let lag = (0..96)
+        .max_by(|&a, &b| {
+            let c = |k: usize| (0..n - k).map(|i| hl[i] * hr[i + k]).sum::<f64>();
+            c(a).total_cmp(&c(b))
+        })
+        .unwrap();
+    let lag_ms = 1e3 * lag as f64 / RATE as f64;
+    assert!(
+        (0.6..=0.7).contains(&lag_ms),
+        "right ear {lag_ms:.3} ms later"
+    );
+    // The head shadows the far ear's highs: 2 (+6 dB) at the near ear, 0.28 (-11 dB) at the far
+    // one, at 180° from it.
+    let level = |x: &[f64]| x.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let shadow_db = db(level(&hl) / level(&hr));
+    assert!(
+        (12.0..20.0).contains(&shadow_db),
+        "highs {shadow_db:.1} dB louder at the near ear"
+    );
+}
+
+#[test]
+fn contacts_sound_and_objects_can_be_both_struck_and_scraped() {
+    let objects = r#"{"name": "o", "bank": "acrylic-plate", "position": [0, 0, -1]}"#;
+    let contact = r#"{"time_s": 0.5, "object": "o",
+        "contact": {"duration_s": 1, "speed_m_per_s": [0.3, 1.0], "force": [0.5, 0.5]}}"#;
+    let (scraped, _) = render(&scene_json(objects, contact, "stereo"));
+    let during = &scraped[RATE as usize..(1.4 * RATE as f64) as usize];
+    let before = &scraped[..(0.49 * RATE as f64) as usize];
+    assert!(
+        rms(before) == 0.0 && rms(during) > 1e-4,
+        "scrape: {}",
+        rms(during)
+    );
+    let both =
+        format!(r#"{contact}, {{"time_s": 0, "object": "o", "impact": {{"speed_m_per_s": 1}}}}"#);
+    let (both, _) = render(&scene_json(objects, &both, "stereo"));
+    assert!(
+        rms(&both[..RATE as usize / 4]) > 1e-3,
+        "the strike sounds too"
+    );
+    // Past the strike's ring the contact alone sounds, as it did alone.
+    let k = RATE as usize;
+    let diff: Vec<f32> = both[k..k + 4800]
+        .iter()
+        .zip(&scraped[k..])
+        .map(|(a, b)| a - b)
+        .collect();
+    assert!(rms(&diff) < 0.05 * rms(&scraped[k..k + 4800]));
+}
+
+#[test]
+fn a_scene_renders_the_same_twice() {
+    let objects = format!(
+        r#"{{"name": "a", "bank": "{BAR}", "position": [-1, 0, -2]}},
+           {{"name": "b", "bank": "acrylic-plate", "position": [2, 1, -1], "scale": 1.5}}"#
+    );
+    let events: Vec<String> = (0..20)
+        .map(|i| {
+            format!(
+                r#"{{"time_s": {}, "object": "{}", "impact": {{"speed_m_per_s": {}}}}}"#,
+                0.05 * i as f64,
+                if i % 3 == 0 { "a" } else { "b" },
+                0.5 + 0.1 * i as f64
+            )
+        })
+        .collect();
+    let text = scene_json(&objects, &events.join(","), "binaural");
+    assert_eq!(render(&text), render(&text));
+}
+
+/// The problems of scene text, one per line.
+fn problems(text: &str) -> String {
+    match parse_scene_str(text, "scene.json") {
+        Ok(file) => match SceneSource::new(file, "scene.json", |spec| {
+            modal_resonator::bank::factory::factory_bank(spec)
+                .ok_or_else(|| format!("no factory bank named \"{spec}\""))
+        }) {
+            Ok(_) => String::new(),
+            Err(e) => e.to_string(),
+        },
+        Err(e) => e.to_string(),
+    }
+}
+
+#[test]
+fn broken_scenes_are_errors_naming_the_place() {
+    let ok_object = format!(r#"{{"name": "o", "bank": "{BAR}", "position": [0, 0, -1]}}"#);
+    let impact = r#"{"time_s": 0, "object": "o", "impact": {"speed_m_per_s": 1}}"#;
+    assert_eq!(problems(&scene_json(&ok_object, impact, "stereo")), "");
+    let cases = [
+        (
+            scene_json(
+                r#"{"name": "o", "bank": "no-such-bank", "position": [0, 0, 1]}"#,
+                "",
+                "stereo",
+            ),
+            "scene.json: objects[0].bank: no factory bank named \"no-such-bank\"",
+        ),
+        (
+            scene_json(
+                r#"{"name": "o", "bank": "x", "position": [0, 0, 1], "mass": 2}"#,
+                "",
+                "stereo",
+            ),
+            "unknown field `mass`",
+        ),
+        (
+            scene_json(
+                &ok_object,
+                r#"{"time_s": 0, "object": "p", "impact": {"speed_m_per_s": 1}}"#,
+                "stereo",
+            ),
+            "scene.json: events[0].object: no object is named \"p\"",
+        ),
+        (
+            scene_json(
+                &ok_object,
+                r#"{"time_s": 0, "object": "o", "impact": {"speed_m_per_s": -3}}"#,
+                "stereo",
+            ),
+            "events[0].impact.speed_m_per_s: expected over 0 up to 1000 m/s, found -3",
+        ),
+        (
+            scene_json(&ok_object, r#"{"time_s": 0, "object": "o"}"#, "stereo"),
+            "events[0]: expected exactly one of \"impact\" and \"contact\", found neither",
+        ),
+        (
+            scene_json(&format!(r#"{ok_object}, {ok_object}"#), "", "stereo"),
+            "objects[1].name: \"o\" names another object too",
+        ),
+        (
+            scene_json(
+                r#"{"name": "o", "bank": "x", "position": [0, 0, 1e400]}"#,
+                "",
+                "stereo",
+            ),
+            "number out of range",
+        ),
+        (
+            scene_json(
+                r#"{"name": "o", "bank": "x", "position": [0, 0, 1e9]}"#,
+                "",
+                "stereo",
+            ),
+            "objects[0].position[2]: expected metres within 100000 of the origin, found 1000000000",
+        ),
+        (
+            scene_json(
+                &format!(r#"{{"name": "o", "bank": "{BAR}", "position": [0, 0, 1], "scale": 9}}"#),
+                "",
+                "stereo",
+            ),
+            "objects[0].scale: expected 0.25 to 4, found 9",
+        ),
+        (
+            scene_json(
+                &format!(
+                    r#"{{"name": "o", "bank": "{BAR}", "position": [0, 0, 1], "set": {{"material": "cheese"}}}}"#
+                ),
+                "",
+                "stereo",
+            ),
+            "objects[0].set.material:",
+        ),
+        (
+            scene_json(&ok_object, "", "surround"),
+            "unknown variant `surround`, expected `stereo` or `binaural`",
+        ),
+        (
+            r#"{"format": "modal-bank", "version": 1}"#.to_string(),
+            "scene.json: format: expected \"modal-scene\", found \"modal-bank\"",
+        ),
+    ];
+    for (text, expected) in &cases {
+        let got = problems(text);
+        assert!(got.contains(expected), "expected {expected:?} in {got:?}");
+    }
+    // Too many objects: refused with the limit, before any bank is looked for.
+    let many: Vec<String> = (0..=MAX_OBJECTS)
+        .map(|i| format!(r#"{{"name": "o{i}", "bank": "nowhere", "position": [0, 0, 1]}}"#))
+        .collect();
+    let got = problems(&scene_json(&many.join(","), "", "stereo"));
+    assert!(
+        got.contains(&format!(
+            "objects: {} objects, at most {MAX_OBJECTS}",
+            MAX_OBJECTS + 1
+        )),
+        "{got}"
+    );
+}
+
+/// The committed schema is the one the types generate. To regenerate it after changing the
+/// types: `UPDATE_SCHEMA=1 cargo test --test scene`.
+#[test]
+fn committed_scene_schema_matches_the_types() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/modal-scene.schema.json");
+    let generated = scene_schema_json();
+    if std::env::var_os("UPDATE_SCHEMA").is_some() {
+        fs::write(&path, &generated).expect("write presets/modal-scene.schema.json");
+    }
+    let committed = fs::read_to_string(&path).unwrap_or_default();
+    assert!(
+        committed == generated,
+        "{} is out of date; regenerate it with `UPDATE_SCHEMA=1 cargo test --test scene`",
+        path.display()
+    );
+}
+
+#[test]
+fn the_command_line_renders_a_scene_and_writes_nothing_on_a_bad_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let bin = env!("CARGO_BIN_EXE_modal-resonator");
+    // Every scene in presets/scenes renders, its bank files found beside it.
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("presets/scenes");
+    let mut rendered = 0;
+    for entry in fs::read_dir(&scenes).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "json") {
+            continue;
+        }
+        let out = dir.path().join("out.wav");
+        let run = Command::new(bin)
+            .args(["scene", path.to_str().unwrap(), "-o", out.to_str().unwrap()])
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&run.stdout);
+        assert!(
+            run.status.success(),
+            "{}: {}",
+            path.display(),
+            String::from_utf8_lossy(&run.stderr)
+        );
+        assert!(stdout.contains("impact"), "{stdout}");
+        let reader = hound::WavReader::open(&out).unwrap();
+        assert!(reader.duration() > RATE / 2, "{}", path.display());
+        rendered += 1;
+    }
+    assert!(rendered >= 1);
+    // A scene naming a bank file that is not there: an error, and no file.
+    let bad = dir.path().join("bad.json");
+    fs::write(
+        &bad,
+        scene_json(
+            r#"{"name": "o", "bank": "banks/gone.json", "position": [0, 0, 1]}"#,
+            "",
+            "stereo",
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("bad.wav");
+    let run = Command::new(bin)
+        .args(["scene", bad.to_str().unwrap(), "-o", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success());
+    assert!(
+        stderr.contains("objects[0].bank: no bank file") && stderr.contains("gone.json"),
+        "{stderr}"
+    );
+    assert!(!out.exists());
+    // The schema.
+    let run = Command::new(bin)
+        .args(["schema", "--scene"])
+        .output()
+        .unwrap();
+    assert_eq!(String::from_utf8_lossy(&run.stdout), scene_schema_json());
+}
