@@ -24,6 +24,7 @@
 pub mod format;
 pub mod listener;
 mod object;
+pub mod physics;
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -35,7 +36,7 @@ use crate::bank::{load_bank_file, Bank};
 use crate::engine::{Controls, ExciterKind, PreparedBank};
 use crate::render::{schedule, Note};
 use crate::units::db_to_gain;
-use format::{SceneError, SceneFile, SceneObject};
+use format::{SceneError, SceneEvent, SceneFile, SceneObject};
 use listener::{air_absorption_db_per_m, place};
 use object::SoundingObject;
 
@@ -59,8 +60,14 @@ pub struct SceneSource {
     pub file: SceneFile,
     /// The banks, one per distinct `bank` of the objects.
     banks: Vec<Bank>,
-    /// Index into `banks` of each object's bank.
-    bank_of: Vec<usize>,
+    /// Index into `banks` of each object's bank; `None` for a silent object.
+    bank_of: Vec<Option<usize>>,
+    /// Every event: the file's, then the impacts the physics found.
+    events: Vec<SceneEvent>,
+    /// Physics steps taken.
+    physics_steps: usize,
+    /// Seconds the physics took to simulate.
+    physics_s: f64,
 }
 
 impl SceneSource {
@@ -91,14 +98,18 @@ impl SceneSource {
         let mut bank_of = Vec::with_capacity(file.objects.len());
         let mut problems = Vec::new();
         for (i, o) in file.objects.iter().enumerate() {
-            if let Some(&k) = index.get(o.bank.as_str()) {
-                bank_of.push(k);
+            let Some(spec) = o.bank.as_deref() else {
+                bank_of.push(None);
+                continue;
+            };
+            if let Some(&k) = index.get(spec) {
+                bank_of.push(Some(k));
                 continue;
             }
-            match resolve(&o.bank) {
+            match resolve(spec) {
                 Ok(bank) => {
-                    index.insert(&o.bank, banks.len());
-                    bank_of.push(banks.len());
+                    index.insert(spec, banks.len());
+                    bank_of.push(Some(banks.len()));
                     banks.push(bank);
                 }
                 Err(message) => {
@@ -106,25 +117,35 @@ impl SceneSource {
                         path: format!("objects[{i}].bank"),
                         message,
                     });
-                    bank_of.push(usize::MAX);
+                    bank_of.push(None);
                 }
             }
         }
+        problems.extend(physics::check_places(&file));
         if !problems.is_empty() {
             return Err(SceneError {
                 origin: origin.to_string(),
                 problems,
             });
         }
+        let started = std::time::Instant::now();
+        let simulated = physics::simulate(&file);
+        let physics_s = started.elapsed().as_secs_f64();
+        let mut events = file.events.clone();
+        events.extend(simulated.events);
         let source = Self {
             file,
             banks,
             bank_of,
+            events,
+            physics_steps: simulated.steps,
+            physics_s,
         };
         // Controls are checked now, not when the scene is played.
         for (i, o) in source.file.objects.iter().enumerate() {
+            let Some(k) = source.bank_of[i] else { continue };
             source
-                .controls(o, &source.banks[source.bank_of[i]])
+                .controls(o, &source.banks[k])
                 .map_err(|(name, message)| SceneError {
                     origin: origin.to_string(),
                     problems: vec![Problem {
@@ -134,6 +155,16 @@ impl SceneSource {
                 })?;
         }
         Ok(source)
+    }
+
+    /// Every event, the file's and the impacts its physics found.
+    pub fn events(&self) -> &[SceneEvent] {
+        &self.events
+    }
+
+    /// Physics steps taken, and the seconds they took.
+    pub fn physics_cost(&self) -> (usize, f64) {
+        (self.physics_steps, self.physics_s)
     }
 
     /// The object's controls: the bank's defaults, the scene's (key tracking and the velocity's
@@ -213,14 +244,14 @@ impl Scene {
             .map(|b| Arc::new(PreparedBank::new(b)))
             .collect();
         let file = &source.file;
-        let mut by_object: Vec<Vec<&format::SceneEvent>> = vec![Vec::new(); file.objects.len()];
+        let mut by_object: Vec<Vec<&SceneEvent>> = vec![Vec::new(); file.objects.len()];
         let index: HashMap<&str, usize> = file
             .objects
             .iter()
             .enumerate()
             .map(|(i, o)| (o.name.as_str(), i))
             .collect();
-        for e in &file.events {
+        for e in &source.events {
             by_object[index[e.object.as_str()]].push(e);
         }
         let mut stats = SceneStats {
@@ -231,8 +262,9 @@ impl Scene {
             .objects
             .iter()
             .enumerate()
-            .map(|(i, o)| {
-                let bank = &source.banks[source.bank_of[i]];
+            .filter_map(|(i, o)| Some((i, o, source.bank_of[i]?)))
+            .map(|(i, o, k)| {
+                let bank = &source.banks[k];
                 let controls = source
                     .controls(o, bank)
                     .expect("controls were checked when the scene was read");
@@ -240,7 +272,7 @@ impl Scene {
                 let r = placement.distance_m;
                 let scale = o.scale;
                 // The air's absorption over the distance, at each mode's frequency as played.
-                let heard = prepared[source.bank_of[i]].with_mode_gains(|f| {
+                let heard = prepared[k].with_mode_gains(|f| {
                     db_to_gain((-air_absorption_db_per_m(f / scale) * r) as f32)
                 });
                 let events = &by_object[i];
@@ -300,7 +332,7 @@ impl Scene {
 /// fastest`, as the object's output is scaled by `fastest`).
 fn parts(
     controls: &Controls,
-    events: &[&format::SceneEvent],
+    events: &[&SceneEvent],
     fastest: f64,
     rate: f64,
     stats: &mut SceneStats,

@@ -399,3 +399,133 @@ fn the_command_line_renders_a_scene_and_writes_nothing_on_a_bad_one() {
         .unwrap();
     assert_eq!(String::from_utf8_lossy(&run.stdout), scene_schema_json());
 }
+
+/// A steel ball dropped from `height_m` (its bottom over the floor's top) onto a fixed spruce
+/// floor that sounds, and what it played.
+fn dropped(height_m: f64, seconds: f64) -> (SceneSource, String) {
+    let text = format!(
+        r#"{{"format": "modal-scene", "version": 1,
+            "objects": [
+              {{"name": "floor", "bank": "spruce-panel", "position": [0, -0.05, -1],
+                "body": {{"collider": {{"cuboid": {{"half_extents_m": [1, 0.05, 1]}}}}}}}},
+              {{"name": "ball", "position": [0, {}, -1],
+                "body": {{"dynamic": true, "collider": {{"ball": {{"radius_m": 0.02}}}},
+                         "density_kg_per_m3": 7800, "restitution": 0.5}}}}],
+            "physics": {{"duration_s": {seconds}, "step_s": 0.004}},
+            "listener": {{"position": [0, 0.5, 0]}}}}"#,
+        height_m + 0.02
+    );
+    let file = parse_scene_str(&text, "drop").unwrap_or_else(|e| panic!("{e}"));
+    let source = SceneSource::new(file, "drop", |spec| {
+        modal_resonator::bank::factory::factory_bank(spec).ok_or_else(|| format!("no {spec}"))
+    })
+    .unwrap_or_else(|e| panic!("{e}"));
+    (source, text)
+}
+
+#[test]
+fn a_dropped_ball_strikes_when_and_as_hard_as_it_falls() {
+    let (low, _) = dropped(1.0, 2.0);
+    let first = &low.events()[0];
+    let expected_s = (2.0 * 1.0 / 9.81f64).sqrt();
+    assert!(
+        (first.time_s - expected_s).abs() <= 0.004,
+        "first strike at {} s, a fall of 1 m takes {expected_s:.4} s",
+        first.time_s
+    );
+    let speed = first.impact.unwrap().speed_m_per_s;
+    assert!(
+        (speed / (2.0 * 9.81f64).sqrt() - 1.0).abs() < 0.02,
+        "{speed} m/s"
+    );
+    // The ball bounces, lower each time, and comes to rest: no strike once it lies still.
+    let times: Vec<f64> = low.events().iter().map(|e| e.time_s).collect();
+    assert!(
+        times.len() >= 3 && times.windows(2).all(|w| w[1] > w[0]),
+        "{times:?}"
+    );
+    let (resting, _) = dropped(0.2, 4.0);
+    let last = resting.events().last().unwrap().time_s;
+    assert!(
+        last < 2.0,
+        "still striking at {last} s: {:?}",
+        resting.events()
+    );
+    // Four times the height: twice as fast, 6 dB louder (the first strike alone).
+    let (high, _) = dropped(4.0, 1.0);
+    let ratio = high.events()[0].impact.unwrap().speed_m_per_s / speed;
+    assert!((ratio - 2.0).abs() < 0.05, "speed ratio {ratio}");
+    let first_strike_level = |s: &SceneSource| {
+        let r = render_scene(s, RATE, 60.0, |_| {});
+        let t = s.events()[0].time_s;
+        let from = (t * RATE as f64) as usize;
+        let second = s
+            .events()
+            .get(1)
+            .map_or(r.left.len(), |e| (e.time_s * RATE as f64) as usize);
+        rms(&r.left[from..second.min(from + RATE as usize / 4)])
+    };
+    let louder = db(first_strike_level(&high) / first_strike_level(&low));
+    assert!(
+        (louder - 6.02).abs() < 1.0,
+        "from 4 m: {louder:.2} dB louder"
+    );
+}
+
+#[test]
+fn bodies_placed_wrongly_are_errors() {
+    let floor = r#"{"name": "floor", "bank": "spruce-panel", "position": [0, 0, -1],
+        "body": {"collider": {"cuboid": {"half_extents_m": [1, 0.05, 1]}}}}"#;
+    let cases = [
+        (
+            format!(r#"{floor}, {{"name": "box", "position": [0, 0.02, -1],
+                "body": {{"dynamic": true, "collider": {{"cuboid": {{"half_extents_m": [0.1, 0.1, 0.1]}}}}}}}}"#),
+            "objects[1].position: \"box\" overlaps \"floor\" (objects[0]) by",
+        ),
+        (
+            format!(r#"{floor}, {{"name": "box", "position": [0, 0.5, 0],
+                "body": {{"collider": {{"ball": {{"radius_m": 0.6}}}}}}}}"#),
+            "listener.position: inside \"box\" (objects[1])",
+        ),
+        (
+            format!(r#"{floor}, {{"name": "box", "position": [0, 0.5, -1],
+                "body": {{"dynamic": true, "mass_kg": -2, "collider": {{"ball": {{"radius_m": 0.1}}}}}}}}"#),
+            "objects[1].body.mass_kg: expected over 0 up to 1e9 kg, found -2",
+        ),
+        (
+            format!(r#"{floor}, {{"name": "box", "position": [0, 0.5, -1],
+                "body": {{"collider": {{"ball": {{"radius_m": 0}}}}}}}}"#),
+            "objects[1].body.collider.ball.radius_m: expected metres over 0",
+        ),
+        (
+            format!(r#"{floor}, {{"name": "ghost", "position": [0, 0.5, -1]}}"#),
+            "objects[1]: expected a \"bank\" (it sounds), a \"body\" (it moves or is struck) or both",
+        ),
+    ];
+    for (objects, expected) in &cases {
+        let text = format!(
+            r#"{{"format": "modal-scene", "version": 1, "objects": [{objects}],
+                "physics": {{"duration_s": 1}}}}"#
+        );
+        let got = problems(&text);
+        assert!(got.contains(expected), "expected {expected:?} in {got:?}");
+    }
+    // Too many steps.
+    let text = format!(
+        r#"{{"format": "modal-scene", "version": 1, "objects": [{floor}],
+            "physics": {{"duration_s": 3000, "step_s": 0.0001}}}}"#
+    );
+    assert!(problems(&text).contains("physics.step_s: 3000 s in steps of 0.0001 s is over"));
+}
+
+#[test]
+fn a_simulated_scene_renders_the_same_twice() {
+    let (a, _) = dropped(0.5, 2.0);
+    let (b, _) = dropped(0.5, 2.0);
+    assert_eq!(a.events(), b.events());
+    let (ra, rb) = (
+        render_scene(&a, RATE, 60.0, |_| {}),
+        render_scene(&b, RATE, 60.0, |_| {}),
+    );
+    assert_eq!(ra, rb);
+}

@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use clap::Args;
 
+use modal_resonator::bank::staged::StagedFile;
 use modal_resonator::render::{BitDepth, WavFile};
 use modal_resonator::scene::{render_scene, SceneSource};
 
@@ -28,6 +29,10 @@ pub(super) struct SceneArgs {
     /// Longest render in seconds; the render stops earlier once everything is silent.
     #[arg(long, default_value_t = 60.0)]
     max_seconds: f64,
+    /// Also write every event played, given or found by the physics, one JSON object a line
+    /// in time order (when it happens at the object, which object, what).
+    #[arg(long, value_name = "FILE")]
+    events: Option<PathBuf>,
 }
 
 /// Parses `--bits`.
@@ -48,7 +53,14 @@ pub(super) fn run(args: &SceneArgs) -> Result<(), String> {
         ));
     }
     check_output("-o", &args.output, &[("the scene", args.scene.as_path())])?;
+    if let Some(events) = &args.events {
+        check_output("--events", events, &[("the scene", args.scene.as_path())])?;
+        if events == &args.output {
+            return Err("--events: the same file as -o; write the events elsewhere".into());
+        }
+    }
     let source = SceneSource::from_file(&args.scene).map_err(|e| e.to_string())?;
+    let (steps, physics_s) = source.physics_cost();
     let started = Instant::now();
     let mut progress = Progress::new("rendering");
     let rendered = render_scene(&source, args.rate, args.max_seconds, |d| progress.set(d));
@@ -58,7 +70,16 @@ pub(super) fn run(args: &SceneArgs) -> Result<(), String> {
         WavFile::create(&args.output, args.bits, args.rate).map_err(|e| e.to_string())?;
     file.write(&rendered.left, &rendered.right)
         .map_err(|e| e.to_string())?;
+    let events = match &args.events {
+        Some(path) => Some(stage_events(&source, path)?),
+        None => None,
+    };
     file.finish().map_err(|e| e.to_string())?;
+    if let Some(staged) = events {
+        staged
+            .commit()
+            .map_err(|e| format!("--events {}: {e}", args.events.as_ref().unwrap().display()))?;
+    }
     let seconds = rendered.left.len() as f64 / args.rate as f64;
     let peak = rendered
         .left
@@ -86,6 +107,13 @@ pub(super) fn run(args: &SceneArgs) -> Result<(), String> {
             ""
         },
     );
+    if steps > 0 {
+        let simulated_s = source.file.physics.map_or(0.0, |p| p.duration_s);
+        println!(
+            "physics: {steps} steps ({simulated_s:.2} s) in {physics_s:.2} s ({:.1}x real time)",
+            simulated_s / physics_s.max(1e-9)
+        );
+    }
     if peak > 1.0 && args.bits != BitDepth::Float32 {
         eprintln!(
             "warning: the scene peaks over full scale and is clipped in the {} file: lower the \
@@ -94,4 +122,18 @@ pub(super) fn run(args: &SceneArgs) -> Result<(), String> {
         );
     }
     Ok(())
+}
+
+/// Writes every event of `source`, in time order, one JSON object a line, to a temporary file
+/// beside `path`; committing it puts it in place.
+fn stage_events(source: &SceneSource, path: &std::path::Path) -> Result<StagedFile, String> {
+    let mut events: Vec<_> = source.events().iter().collect();
+    events.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+    let mut text = String::new();
+    for e in events {
+        text.push_str(&serde_json::to_string(e).map_err(|e| e.to_string())?);
+        text.push('\n');
+    }
+    StagedFile::write(path, "events", text.as_bytes())
+        .map_err(|e| format!("--events {}: {e}", path.display()))
 }

@@ -6,7 +6,7 @@
 //! its line and column) -> [`validate`], which collects every problem with its JSON path
 //! (`events[3].object: ...`).
 
-use std::collections::{BTreeMap, HashSet};
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::fmt;
 
 use schemars::JsonSchema;
@@ -60,6 +60,93 @@ pub struct SceneFile {
     /// Who hears them, and how.
     #[serde(default)]
     pub listener: Listener,
+    /// The rigid-body simulation of the objects that have a `body`, whose impacts are events
+    /// too; none without it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub physics: Option<Physics>,
+}
+
+/// How long and how finely the objects' bodies are simulated.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Physics {
+    /// Seconds simulated from the start of the scene.
+    pub duration_s: f64,
+    /// Seconds per step (default 1/240): impacts are timed to a step.
+    #[serde(default = "default_step_s")]
+    pub step_s: f64,
+    /// Gravity, m/s² (default `[0, -9.81, 0]`).
+    #[serde(default = "default_gravity")]
+    pub gravity_m_per_s2: [f64; 3],
+}
+
+fn default_step_s() -> f64 {
+    1.0 / 240.0
+}
+
+fn default_gravity() -> [f64; 3] {
+    [0.0, -9.81, 0.0]
+}
+
+/// An object's rigid body: its shape, and whether it moves.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Body {
+    /// Whether it moves (falls, bounces); a fixed body does not (default false).
+    #[serde(default)]
+    pub dynamic: bool,
+    /// Its shape, centred on its position.
+    pub collider: Collider,
+    /// Its mass, kg; from `density_kg_per_m3` and the shape's volume when not given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mass_kg: Option<f64>,
+    /// Density, kg/m³, when no mass is given (default 1000).
+    #[serde(default = "default_density")]
+    pub density_kg_per_m3: f64,
+    /// Coefficient of restitution, 0 to 1 (default 0.5): how much of the approach speed a
+    /// bounce gives back.
+    #[serde(default = "half")]
+    pub restitution: f64,
+    /// Coefficient of friction (default 0.5).
+    #[serde(default = "half")]
+    pub friction: f64,
+    /// Initial velocity, m/s.
+    #[serde(default)]
+    pub linear_velocity_m_per_s: [f64; 3],
+    /// Initial angular velocity, rad/s about each axis.
+    #[serde(default)]
+    pub angular_velocity_rad_per_s: [f64; 3],
+}
+
+fn default_density() -> f64 {
+    1000.0
+}
+
+fn half() -> f64 {
+    0.5
+}
+
+/// A body's shape.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum Collider {
+    /// A sphere.
+    Ball {
+        /// Radius, m.
+        radius_m: f64,
+    },
+    /// A box.
+    Cuboid {
+        /// Half its size along x, y and z, m.
+        half_extents_m: [f64; 3],
+    },
+    /// A cylinder along y.
+    Cylinder {
+        /// Half its height, m.
+        half_height_m: f64,
+        /// Radius, m.
+        radius_m: f64,
+    },
 }
 
 /// One sounding object.
@@ -68,8 +155,10 @@ pub struct SceneFile {
 pub struct SceneObject {
     /// Its name, unique in the scene: events name the object they sound.
     pub name: String,
-    /// Its bank: a factory bank's name, or a bank file (relative to the scene file).
-    pub bank: String,
+    /// Its bank: a factory bank's name, or a bank file (relative to the scene file). Without
+    /// one the object is silent (a body other objects strike).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bank: Option<String>,
     /// Where it is, metres `[x, y, z]`.
     pub position: [f64; 3],
     /// How much larger than its bank it is: pitch falls as the scale grows, as with the size
@@ -84,6 +173,9 @@ pub struct SceneObject {
     /// (e.g. `{"material": "wood", "hardness_ms": "0.5"}`).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub set: BTreeMap<String, String>,
+    /// Its rigid body, for the physics.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<Body>,
 }
 
 fn one() -> f64 {
@@ -284,11 +376,22 @@ pub fn validate(scene: &SceneFile) -> Vec<Problem> {
                 format!("\"{}\" names another object too", o.name),
             );
         }
-        if o.bank.trim().is_empty() {
-            add(
-                at("bank"),
-                "expected a factory bank's name or a bank file".into(),
-            );
+        match &o.bank {
+            Some(bank) if bank.trim().is_empty() => {
+                add(
+                    at("bank"),
+                    "expected a factory bank's name or a bank file".into(),
+                );
+            }
+            None if o.body.is_none() => add(
+                format!("objects[{i}]"),
+                "expected a \"bank\" (it sounds), a \"body\" (it moves or is struck) or both"
+                    .into(),
+            ),
+            _ => {}
+        }
+        if let Some(body) = &o.body {
+            check_body(body, &at("body"), &mut add);
         }
         check_point(&o.position, &at("position"), &mut add);
         if !(SCALE_RANGE.0..=SCALE_RANGE.1).contains(&o.scale) {
@@ -307,6 +410,12 @@ pub fn validate(scene: &SceneFile) -> Vec<Problem> {
             );
         }
     }
+    // Whether each object has a bank, by name.
+    let sounds: HashMap<&str, bool> = scene
+        .objects
+        .iter()
+        .map(|o| (o.name.as_str(), o.bank.is_some()))
+        .collect();
     for (i, e) in scene.events.iter().enumerate() {
         let at = |field: &str| format!("events[{i}].{field}");
         if !(0.0..=MAX_EVENT_TIME_S).contains(&e.time_s) {
@@ -315,8 +424,13 @@ pub fn validate(scene: &SceneFile) -> Vec<Problem> {
                 format!("expected 0 to {MAX_EVENT_TIME_S} s, found {}", e.time_s),
             );
         }
-        if !names.contains(e.object.as_str()) {
-            add(at("object"), format!("no object is named \"{}\"", e.object));
+        match sounds.get(e.object.as_str()) {
+            None => add(at("object"), format!("no object is named \"{}\"", e.object)),
+            Some(false) => add(
+                at("object"),
+                format!("\"{}\" has no bank: it cannot sound", e.object),
+            ),
+            Some(true) => {}
         }
         match (&e.impact, &e.contact) {
             (Some(impact), None) => {
@@ -363,6 +477,39 @@ pub fn validate(scene: &SceneFile) -> Vec<Problem> {
             ),
         }
     }
+    if let Some(p) = &scene.physics {
+        if !(p.duration_s > 0.0 && p.duration_s <= MAX_EVENT_TIME_S) {
+            add(
+                "physics.duration_s".into(),
+                format!(
+                    "expected over 0 up to {MAX_EVENT_TIME_S} s, found {}",
+                    p.duration_s
+                ),
+            );
+        }
+        if !(1e-5..=0.1).contains(&p.step_s) {
+            add(
+                "physics.step_s".into(),
+                format!("expected 0.00001 to 0.1 s, found {}", p.step_s),
+            );
+        } else if p.duration_s / p.step_s > MAX_STEPS {
+            add(
+                "physics.step_s".into(),
+                format!(
+                    "{} s in steps of {} s is over {MAX_STEPS} steps",
+                    p.duration_s, p.step_s
+                ),
+            );
+        }
+        for (k, g) in p.gravity_m_per_s2.iter().enumerate() {
+            if !g.is_finite() || g.abs() > 1000.0 {
+                add(
+                    format!("physics.gravity_m_per_s2[{k}]"),
+                    format!("expected -1000 to 1000 m/s², found {g}"),
+                );
+            }
+        }
+    }
     let l = &scene.listener;
     check_point(&l.position, "listener.position", &mut add);
     let f = l.forward;
@@ -386,6 +533,87 @@ fn check_point(p: &[f64; 3], path: &str, add: &mut impl FnMut(String, String)) {
                 format!("{path}[{k}]"),
                 format!("expected metres within {MAX_COORDINATE_M} of the origin, found {v}"),
             );
+        }
+    }
+}
+
+/// Most physics steps a scene may take.
+pub const MAX_STEPS: f64 = 2e6;
+
+/// Checks a body: a shape of positive size, a positive mass or density, coefficients in range,
+/// finite velocities.
+fn check_body(b: &Body, path: &str, add: &mut impl FnMut(String, String)) {
+    let size_ok = |v: f64| v > 0.0 && v <= MAX_COORDINATE_M;
+    let sizes: Vec<(&str, f64)> = match b.collider {
+        Collider::Ball { radius_m } => vec![("ball.radius_m", radius_m)],
+        Collider::Cuboid { half_extents_m } => (0..3)
+            .map(|k| {
+                (
+                    [
+                        "cuboid.half_extents_m[0]",
+                        "cuboid.half_extents_m[1]",
+                        "cuboid.half_extents_m[2]",
+                    ][k],
+                    half_extents_m[k],
+                )
+            })
+            .collect(),
+        Collider::Cylinder {
+            half_height_m,
+            radius_m,
+        } => vec![
+            ("cylinder.half_height_m", half_height_m),
+            ("cylinder.radius_m", radius_m),
+        ],
+    };
+    for (name, v) in sizes {
+        if !size_ok(v) {
+            add(
+                format!("{path}.collider.{name}"),
+                format!("expected metres over 0 up to {MAX_COORDINATE_M}, found {v}"),
+            );
+        }
+    }
+    if let Some(m) = b.mass_kg {
+        if !(m > 0.0 && m <= 1e9) {
+            add(
+                format!("{path}.mass_kg"),
+                format!("expected over 0 up to 1e9 kg, found {m}"),
+            );
+        }
+    }
+    if !(b.density_kg_per_m3 > 0.0 && b.density_kg_per_m3 <= 1e5) {
+        add(
+            format!("{path}.density_kg_per_m3"),
+            format!(
+                "expected over 0 up to 100000 kg/m³, found {}",
+                b.density_kg_per_m3
+            ),
+        );
+    }
+    if !(0.0..=1.0).contains(&b.restitution) {
+        add(
+            format!("{path}.restitution"),
+            format!("expected 0 to 1, found {}", b.restitution),
+        );
+    }
+    if !(0.0..=10.0).contains(&b.friction) {
+        add(
+            format!("{path}.friction"),
+            format!("expected 0 to 10, found {}", b.friction),
+        );
+    }
+    for (name, v) in [
+        ("linear_velocity_m_per_s", b.linear_velocity_m_per_s),
+        ("angular_velocity_rad_per_s", b.angular_velocity_rad_per_s),
+    ] {
+        for (k, x) in v.iter().enumerate() {
+            if !x.is_finite() || x.abs() > MAX_SPEED_M_PER_S {
+                add(
+                    format!("{path}.{name}[{k}]"),
+                    format!("expected -{MAX_SPEED_M_PER_S} to {MAX_SPEED_M_PER_S}, found {x}"),
+                );
+            }
         }
     }
 }
