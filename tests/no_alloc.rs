@@ -231,3 +231,41 @@ fn pruning_and_the_budget_never_allocate() {
         "no strike met a dormant mode"
     );
 }
+
+#[test]
+fn a_scene_steps_without_allocating() {
+    use modal_resonator::scene::{parse_scene_str, Scene, SceneSource};
+    // Objects struck, scraped and simulated, heard binaurally, stepped in blocks of mixed sizes.
+    let text = r#"{"format": "modal-scene", "version": 1,
+        "objects": [
+          {"name": "floor", "bank": "spruce-panel", "position": [0, -0.05, -1],
+           "body": {"collider": {"cuboid": {"half_extents_m": [1, 0.05, 1]}}}},
+          {"name": "ball", "position": [0, 0.5, -1],
+           "body": {"dynamic": true, "collider": {"ball": {"radius_m": 0.02}}}},
+          {"name": "bar", "bank": "steel-free-free-bar", "position": [-1, 0, -1]}],
+        "events": [
+          {"time_s": 0.01, "object": "bar", "impact": {"speed_m_per_s": 1}},
+          {"time_s": 0.02, "object": "bar", "impact": {"speed_m_per_s": 2}},
+          {"time_s": 0.1, "object": "floor",
+           "contact": {"duration_s": 0.5, "speed_m_per_s": [0.2, 1], "force": [0.5, 0.5]}}],
+        "physics": {"duration_s": 1.5},
+        "listener": {"position": [0, 1, 0], "output": "binaural"}}"#;
+    let file = parse_scene_str(text, "test").unwrap();
+    let source = SceneSource::new(file, "test", |spec| {
+        modal_resonator::bank::factory::factory_bank(spec).ok_or_else(|| format!("no {spec}"))
+    })
+    .unwrap();
+    assert!(source.events().len() > 4, "the ball strikes the floor");
+    let mut scene = Scene::new(&source, 48_000, 512);
+    let (mut l, mut r) = (vec![0.0f32; 512], vec![0.0f32; 512]);
+    let mut heard = 0.0f32;
+    let count = allocations_in(|| {
+        for k in 0..200 {
+            let n = [512, 64, 1, 300][k % 4];
+            scene.process(&mut l[..n], &mut r[..n]);
+            heard = heard.max(l[..n].iter().fold(0.0, |a, v| a.max(v.abs())));
+        }
+    });
+    assert!(heard > 0.0);
+    assert_eq!(count, 0, "the scene allocated {count} times while playing");
+}
