@@ -50,6 +50,23 @@ const KEY: u8 = 60;
 /// own level (and its `gain_db`).
 const REFERENCE_SPEED_M_PER_S: f64 = 1.0;
 
+/// Controls an object's `set` may not give, and why: the scene's laws rest on them.
+const SET_BY_THE_SCENE: [(&str, &str); 4] = [
+    ("size_ratio", "give the object's \"scale\" instead"),
+    (
+        "key_tracking",
+        "every object plays its bank as authored, lowered by its scale",
+    ),
+    (
+        "velocity_sensitivity",
+        "an impact's loudness is proportional to its speed",
+    ),
+    (
+        "target_load_pct",
+        "a load target depends on the machine; use mode_budget",
+    ),
+];
+
 /// Silence kept after the last sound, in seconds.
 pub const TAIL_S: f64 = 0.1;
 
@@ -57,7 +74,7 @@ pub const TAIL_S: f64 = 0.1;
 #[derive(Debug, Clone)]
 pub struct SceneSource {
     /// The scene.
-    pub file: SceneFile,
+    file: SceneFile,
     /// The banks, one per distinct `bank` of the objects.
     banks: Vec<Bank>,
     /// Index into `banks` of each object's bank; `None` for a silent object.
@@ -66,6 +83,8 @@ pub struct SceneSource {
     events: Vec<SceneEvent>,
     /// Physics steps taken.
     physics_steps: usize,
+    /// Whether the physics found more impacts than a scene may hold, and the rest were left out.
+    events_capped: bool,
     /// Seconds the physics took to simulate.
     physics_s: f64,
 }
@@ -93,6 +112,14 @@ impl SceneSource {
         origin: &str,
         mut resolve: impl FnMut(&str) -> Result<Bank, String>,
     ) -> Result<Self, SceneError> {
+        let invalid = |problems: Vec<Problem>| SceneError {
+            origin: origin.to_string(),
+            problems,
+        };
+        let problems = format::validate(&file);
+        if !problems.is_empty() {
+            return Err(invalid(problems));
+        }
         let mut banks = Vec::new();
         let mut index: HashMap<&str, usize> = HashMap::new();
         let mut bank_of = Vec::with_capacity(file.objects.len());
@@ -128,38 +155,45 @@ impl SceneSource {
                 problems,
             });
         }
+        // Controls are checked before anything is simulated.
+        for (i, o) in file.objects.iter().enumerate() {
+            let Some(k) = bank_of[i] else { continue };
+            Self::controls(o, &banks[k]).map_err(|(name, message)| {
+                invalid(vec![Problem {
+                    path: format!("objects[{i}].set.{name}"),
+                    message,
+                }])
+            })?;
+        }
         let started = std::time::Instant::now();
         let simulated = physics::simulate(&file);
         let physics_s = started.elapsed().as_secs_f64();
         let mut events = file.events.clone();
         events.extend(simulated.events);
-        let source = Self {
+        Ok(Self {
             file,
             banks,
             bank_of,
             events,
             physics_steps: simulated.steps,
             physics_s,
-        };
-        // Controls are checked now, not when the scene is played.
-        for (i, o) in source.file.objects.iter().enumerate() {
-            let Some(k) = source.bank_of[i] else { continue };
-            source
-                .controls(o, &source.banks[k])
-                .map_err(|(name, message)| SceneError {
-                    origin: origin.to_string(),
-                    problems: vec![Problem {
-                        path: format!("objects[{i}].set.{name}"),
-                        message,
-                    }],
-                })?;
-        }
-        Ok(source)
+            events_capped: simulated.capped,
+        })
+    }
+
+    /// The scene.
+    pub fn file(&self) -> &SceneFile {
+        &self.file
     }
 
     /// Every event, the file's and the impacts its physics found.
     pub fn events(&self) -> &[SceneEvent] {
         &self.events
+    }
+
+    /// Whether the physics found more impacts than a scene may hold (the rest left out).
+    pub fn events_capped(&self) -> bool {
+        self.events_capped
     }
 
     /// Physics steps taken, and the seconds they took.
@@ -169,7 +203,7 @@ impl SceneSource {
 
     /// The object's controls: the bank's defaults, the scene's (key tracking and the velocity's
     /// hardness off, a linear velocity curve, width 0, the scale as the size), then its `set`.
-    fn controls(&self, o: &SceneObject, bank: &Bank) -> Result<Controls, (String, String)> {
+    fn controls(o: &SceneObject, bank: &Bank) -> Result<Controls, (String, String)> {
         let mut c = Controls::for_bank(bank);
         c.key_tracking = 0.0;
         c.velocity_sensitivity = 0.5;
@@ -177,6 +211,9 @@ impl SceneSource {
         c.width = 0.0;
         c.size_ratio = o.scale as f32;
         for (name, value) in &o.set {
+            if let Some(instead) = SET_BY_THE_SCENE.iter().find(|(n, _)| n == name) {
+                return Err((name.clone(), format!("set by the scene: {}", instead.1)));
+            }
             c.set_by_name(name, value).map_err(|e| (name.clone(), e))?;
         }
         Ok(c)
@@ -220,7 +257,8 @@ pub struct SceneStats {
 }
 
 /// A scene prepared to play: step it with [`Scene::process`]. Building allocates; processing
-/// does not, once a block has held as many events as it ever will.
+/// never does. The same blocks give the same samples; other block sizes may differ in the last
+/// bits (an idle object's engine waits, so its control ticks fall where its blocks do).
 pub struct Scene {
     /// The objects.
     objects: Vec<SoundingObject>,
@@ -237,6 +275,7 @@ pub struct Scene {
 impl Scene {
     /// Prepares `source` to play at `sample_rate_hz` in blocks of at most `max_block` samples.
     pub fn new(source: &SceneSource, sample_rate_hz: u32, max_block: usize) -> Self {
+        let max_block = max_block.max(1);
         let rate = sample_rate_hz as f64;
         let prepared: Vec<Arc<PreparedBank>> = source
             .banks
@@ -265,8 +304,7 @@ impl Scene {
             .filter_map(|(i, o)| Some((i, o, source.bank_of[i]?)))
             .map(|(i, o, k)| {
                 let bank = &source.banks[k];
-                let controls = source
-                    .controls(o, bank)
+                let controls = SceneSource::controls(o, bank)
                     .expect("controls were checked when the scene was read");
                 let placement = place(&file.listener, o.position);
                 let r = placement.distance_m;
@@ -278,10 +316,10 @@ impl Scene {
                 let events = &by_object[i];
                 let fastest = events
                     .iter()
-                    .filter_map(|e| e.impact.map(|x| x.speed_m_per_s))
+                    .filter_map(|e| e.impact.map(|x| x.strength()))
                     .fold(REFERENCE_SPEED_M_PER_S, f64::max);
                 let parts = parts(&controls, events, fastest, rate, &mut stats);
-                let gain = fastest / REFERENCE_SPEED_M_PER_S * db_to_gain(o.gain_db as f32) as f64;
+                let gain = db_to_gain(o.gain_db as f32) as f64;
                 SoundingObject::new(&Arc::new(heard), parts, &placement, gain, rate, max_block)
             })
             .collect();
@@ -328,22 +366,23 @@ impl Scene {
 }
 
 /// An object's parts: an engine for its impacts and one for its contacts, each with its events
-/// as notes scheduled at `rate` (impacts at velocity `speed / fastest`, contacts at `1 /
-/// fastest`, as the object's output is scaled by `fastest`).
+/// as notes scheduled at `rate` and its gain: impacts at velocity `strength / fastest`, their
+/// output scaled by `fastest` (in m/s over the reference speed); contacts at velocity 1 and
+/// gain 1, their level set by their force curves.
 fn parts(
     controls: &Controls,
     events: &[&SceneEvent],
     fastest: f64,
     rate: f64,
     stats: &mut SceneStats,
-) -> Vec<(Controls, Vec<crate::render::TimedEvent>)> {
+) -> Vec<(Controls, Vec<crate::render::TimedEvent>, f64)> {
     let mut strikes = Vec::new();
     let mut contacts = Vec::new();
     for e in events {
         if let Some(impact) = e.impact {
             strikes.push(Note::new(
                 KEY,
-                (impact.speed_m_per_s / fastest) as f32,
+                (impact.strength() / fastest) as f32,
                 e.time_s,
                 None,
             ));
@@ -351,7 +390,7 @@ fn parts(
         if let Some(c) = e.contact {
             contacts.push(Note {
                 key: KEY,
-                velocity: (1.0 / fastest) as f32,
+                velocity: 1.0,
                 time_s: e.time_s,
                 duration_s: Some(c.duration_s),
                 speed_m_per_s: Some((c.speed_m_per_s[0], c.speed_m_per_s[1])),
@@ -368,14 +407,18 @@ fn parts(
         if c.exciter.is_contact() {
             c.exciter = ExciterKind::Mallet;
         }
-        out.push((c, schedule(&strikes, rate, until_s)));
+        out.push((
+            c,
+            schedule(&strikes, rate, until_s),
+            fastest / REFERENCE_SPEED_M_PER_S,
+        ));
     }
     if !contacts.is_empty() {
         let mut c = controls.clone();
         if !c.exciter.is_contact() {
             c.exciter = ExciterKind::Scrape;
         }
-        out.push((c, schedule(&contacts, rate, until_s)));
+        out.push((c, schedule(&contacts, rate, until_s), 1.0));
     }
     out
 }
@@ -393,54 +436,114 @@ pub struct RenderedScene {
     pub stats: SceneStats,
 }
 
-/// Renders `source` at `sample_rate_hz` into memory, up to `max_seconds` (faded over the last
-/// 10 ms if it still sounds there), [`TAIL_S`] of silence kept after the last sound;
-/// `progress` hears the share done (an estimate until the end).
+/// What [`render_scene_to`] rendered.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SceneSummary {
+    /// Samples per channel.
+    pub len: usize,
+    /// Largest sample magnitude.
+    pub peak: f32,
+    /// Whether `max_seconds` cut it while it still sounded.
+    pub cut_short: bool,
+    /// What the scene held.
+    pub stats: SceneStats,
+}
+
+/// Renders `source` at `sample_rate_hz` into memory, as [`render_scene_to`] renders it.
 pub fn render_scene(
     source: &SceneSource,
     sample_rate_hz: u32,
     max_seconds: f64,
-    mut progress: impl FnMut(f64),
+    progress: impl FnMut(f64),
 ) -> RenderedScene {
-    const BLOCK: usize = 256;
-    let rate = sample_rate_hz as f64;
-    let max_samples = (max_seconds.max(0.0) * rate).round() as usize;
-    let mut scene = Scene::new(source, sample_rate_hz, BLOCK);
     let (mut left, mut right) = (Vec::new(), Vec::new());
-    let (mut l, mut r) = (vec![0.0f32; BLOCK], vec![0.0f32; BLOCK]);
-    let mut last_sound = 0usize;
-    let estimate = (scene.last_event_sample() as f64 + 2.0 * rate).min(max_samples as f64);
-    while left.len() < max_samples && !(scene.is_done() && left.len() as u64 > scene.last_event) {
-        let n = BLOCK.min(max_samples - left.len());
-        scene.process(&mut l[..n], &mut r[..n]);
-        if let Some(k) = (0..n).rev().find(|&k| l[k] != 0.0 || r[k] != 0.0) {
-            last_sound = left.len() + k + 1;
-        }
-        left.extend_from_slice(&l[..n]);
-        right.extend_from_slice(&r[..n]);
-        progress((left.len() as f64 / estimate.max(1.0)).min(0.99));
-    }
-    let cut_short = !scene.is_done();
-    if cut_short {
-        let fade = ((0.01 * rate) as usize).min(left.len());
-        let start = left.len() - fade;
-        for k in 0..fade {
-            let g = 1.0 - (k + 1) as f32 / fade as f32;
-            left[start + k] *= g;
-            right[start + k] *= g;
-        }
-    } else {
-        // Silent from `last_sound` on: cut there, or padded with silence, to the tail's end.
-        let heard_to = last_sound.max(scene.last_event_sample() as usize + 1);
-        let end = (heard_to + (TAIL_S * rate) as usize).min(max_samples);
-        left.resize(end, 0.0);
-        right.resize(end, 0.0);
-    }
-    progress(1.0);
+    let sink = |l: &[f32], r: &[f32]| {
+        left.extend_from_slice(l);
+        right.extend_from_slice(r);
+        Ok::<(), std::convert::Infallible>(())
+    };
+    let Ok(summary) = render_scene_to(source, sample_rate_hz, max_seconds, progress, sink);
     RenderedScene {
         left,
         right,
+        cut_short: summary.cut_short,
+        stats: summary.stats,
+    }
+}
+
+/// Samples a scene is rendered in at a time.
+const RENDER_BLOCK: usize = 256;
+
+/// Renders `source` at `sample_rate_hz`, handing the stereo samples to `sink` in order as they
+/// are made, up to `max_seconds` (the last 10 ms before it faded out, for a scene still
+/// sounding there), [`TAIL_S`] of silence kept after the last sound or event; `progress` hears
+/// the share done (an estimate until the end). Memory does not grow with the length: only a
+/// run of silence, counted, waits before going to the sink. Stops at the first error of `sink`.
+pub fn render_scene_to<E>(
+    source: &SceneSource,
+    sample_rate_hz: u32,
+    max_seconds: f64,
+    mut progress: impl FnMut(f64),
+    mut sink: impl FnMut(&[f32], &[f32]) -> Result<(), E>,
+) -> Result<SceneSummary, E> {
+    let rate = sample_rate_hz as f64;
+    let max_samples = (max_seconds.max(0.0) * rate).round() as usize;
+    let fade_len = ((0.01 * rate) as usize).clamp(1, max_samples.max(1));
+    let fade_start = max_samples.saturating_sub(fade_len);
+    let mut scene = Scene::new(source, sample_rate_hz, RENDER_BLOCK);
+    let (mut l, mut r) = (vec![0.0f32; RENDER_BLOCK], vec![0.0f32; RENDER_BLOCK]);
+    // Samples given to the sink, and silence made since, held back.
+    let (mut written, mut pos) = (0usize, 0usize);
+    let mut peak = 0.0f32;
+    let estimate = (scene.last_event_sample() as f64 + 2.0 * rate).min(max_samples as f64);
+    while pos < max_samples && !(scene.is_done() && pos as u64 > scene.last_event) {
+        let n = RENDER_BLOCK.min(max_samples - pos);
+        scene.process(&mut l[..n], &mut r[..n]);
+        for k in (fade_start.max(pos) - pos)..n {
+            let g = 1.0 - (pos + k - fade_start + 1) as f32 / fade_len as f32;
+            l[k] *= g;
+            r[k] *= g;
+        }
+        if let Some(k) = (0..n).rev().find(|&k| l[k] != 0.0 || r[k] != 0.0) {
+            write_silence(&mut sink, pos - written)?;
+            sink(&l[..=k], &r[..=k])?;
+            peak = l[..=k]
+                .iter()
+                .chain(&r[..=k])
+                .fold(peak, |a, v| a.max(v.abs()));
+            written = pos + k + 1;
+        }
+        pos += n;
+        progress((pos as f64 / estimate.max(1.0)).min(0.99));
+    }
+    let cut_short = !scene.is_done();
+    let end = if cut_short {
+        pos
+    } else {
+        // Silent from `written` on: the tail's silence after the last sound or event.
+        let heard_to = written.max(scene.last_event_sample() as usize + 1);
+        (heard_to + (TAIL_S * rate) as usize).min(max_samples)
+    };
+    write_silence(&mut sink, end.saturating_sub(written))?;
+    progress(1.0);
+    Ok(SceneSummary {
+        len: end.max(written),
+        peak,
         cut_short,
         stats: scene.stats(),
+    })
+}
+
+/// Hands `n` samples of silence to `sink`, a block at a time.
+fn write_silence<E>(
+    sink: &mut impl FnMut(&[f32], &[f32]) -> Result<(), E>,
+    mut n: usize,
+) -> Result<(), E> {
+    let zeros = [0.0f32; RENDER_BLOCK];
+    while n > 0 {
+        let k = n.min(RENDER_BLOCK);
+        sink(&zeros[..k], &zeros[..k])?;
+        n -= k;
     }
+    Ok(())
 }

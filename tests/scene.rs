@@ -363,7 +363,15 @@ fn the_command_line_renders_a_scene_and_writes_nothing_on_a_bad_one() {
             path.display(),
             String::from_utf8_lossy(&run.stderr)
         );
-        assert!(stdout.contains("impact"), "{stdout}");
+        let impacts: usize = stdout
+            .split(", ")
+            .find_map(|part| {
+                part.strip_suffix(" impacts")
+                    .or(part.strip_suffix(" impact"))
+            })
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("no impact count in {stdout}"));
+        assert!(impacts > 0, "{}: {stdout}", path.display());
         let reader = hound::WavReader::open(&out).unwrap();
         assert!(reader.duration() > RATE / 2, "{}", path.display());
         rendered += 1;
@@ -498,6 +506,16 @@ fn bodies_placed_wrongly_are_errors() {
             "objects[1].body.collider.ball.radius_m: expected metres over 0",
         ),
         (
+            format!(r#"{floor}, {{"name": "die", "bank": "rosewood-claves", "position": [0, 0.5, -1],
+                "body": {{"dynamic": true, "collider": {{"ball": {{"radius_m": 0.1}}}}}}}}"#),
+            "objects[1].bank: a dynamic body cannot sound yet",
+        ),
+        (
+            format!(r#"{floor}, {{"name": "bar", "bank": "rosewood-claves", "position": [0, 0.5, -1],
+                "set": {{"velocity_sensitivity": "1"}}}}"#),
+            "objects[1].set.velocity_sensitivity: set by the scene: an impact's loudness is",
+        ),
+        (
             format!(r#"{floor}, {{"name": "ghost", "position": [0, 0.5, -1]}}"#),
             "objects[1]: expected a \"bank\" (it sounds), a \"body\" (it moves or is struck) or both",
         ),
@@ -505,7 +523,7 @@ fn bodies_placed_wrongly_are_errors() {
     for (objects, expected) in &cases {
         let text = format!(
             r#"{{"format": "modal-scene", "version": 1, "objects": [{objects}],
-                "physics": {{"duration_s": 1}}}}"#
+                "physics": {{"duration_s": 1}}, "listener": {{"position": [0, 1, 0]}}}}"#
         );
         let got = problems(&text);
         assert!(got.contains(expected), "expected {expected:?} in {got:?}");
@@ -519,6 +537,34 @@ fn bodies_placed_wrongly_are_errors() {
 }
 
 #[test]
+fn a_box_resting_on_the_floor_never_strikes() {
+    // A box set down on the floor (touching it) and a ball dropped beside it: the ball strikes,
+    // the box, resting, does not chatter.
+    let text = r#"{"format": "modal-scene", "version": 1,
+        "objects": [
+          {"name": "floor", "bank": "spruce-panel", "position": [0, -0.05, -1],
+           "body": {"collider": {"cuboid": {"half_extents_m": [1, 0.05, 1]}}}},
+          {"name": "box", "position": [0.3, 0.1, -1],
+           "body": {"dynamic": true, "collider": {"cuboid": {"half_extents_m": [0.1, 0.1, 0.1]}}}},
+          {"name": "ball", "position": [-0.3, 0.5, -1],
+           "body": {"dynamic": true, "collider": {"ball": {"radius_m": 0.02}}, "restitution": 0.2}}],
+        "physics": {"duration_s": 3},
+        "listener": {"position": [0, 1, 0]}}"#;
+    let file = parse_scene_str(text, "rest").unwrap();
+    let source = SceneSource::new(file, "rest", |spec| {
+        modal_resonator::bank::factory::factory_bank(spec).ok_or_else(|| format!("no {spec}"))
+    })
+    .unwrap();
+    let times: Vec<f64> = source.events().iter().map(|e| e.time_s).collect();
+    // The ball's bounces, from 0.5 m, all within the first second; nothing after.
+    assert!(!times.is_empty() && times[0] > 0.25, "{times:?}");
+    assert!(
+        times.iter().all(|&t| t < 1.2),
+        "strikes after the ball has settled: {times:?}"
+    );
+}
+
+#[test]
 fn a_simulated_scene_renders_the_same_twice() {
     let (a, _) = dropped(0.5, 2.0);
     let (b, _) = dropped(0.5, 2.0);
@@ -528,4 +574,104 @@ fn a_simulated_scene_renders_the_same_twice() {
         render_scene(&b, RATE, 60.0, |_| {}),
     );
     assert_eq!(ra, rb);
+}
+
+#[test]
+fn hail_falls_at_its_rate_on_what_lies_under_it() {
+    use modal_resonator::scene::format::DropKind;
+    use modal_resonator::scene::physics::terminal_speed_m_per_s;
+    // The drag equation for hail, Atlas et al. for rain.
+    let hail = terminal_speed_m_per_s(DropKind::Hail, 0.01);
+    let rain = terminal_speed_m_per_s(DropKind::Rain, 0.002);
+    assert!(
+        (hail - 12.8).abs() < 0.1 && (rain - 6.55).abs() < 0.05,
+        "{hail} {rain}"
+    );
+    // A 1 m square plate under a 2 m by 2 m rectangle: a quarter of the drops strike it.
+    let scene = |seed: u32| {
+        format!(
+            r#"{{"format": "modal-scene", "version": 1,
+                "objects": [{{"name": "plate", "bank": "steel-plate", "position": [0, 0, -2],
+                  "body": {{"collider": {{"cuboid": {{"half_extents_m": [0.5, 0.005, 0.5]}}}}}}}}],
+                "emitters": [{{"kind": "hail", "centre": [0, 5, -2], "half_extents_m": [1, 1],
+                  "rate_per_s": 400, "start_s": 1, "duration_s": 2, "seed": {seed}}}],
+                "listener": {{"position": [0, 1, 0]}}}}"#
+        )
+    };
+    let source = |seed| {
+        let file = parse_scene_str(&scene(seed), "hail").unwrap_or_else(|e| panic!("{e}"));
+        SceneSource::new(file, "hail", |spec| {
+            modal_resonator::bank::factory::factory_bank(spec).ok_or_else(|| format!("no {spec}"))
+        })
+        .unwrap_or_else(|e| panic!("{e}"))
+    };
+    let a = source(1);
+    let n = a.events().len() as f64;
+    // 800 drops, a quarter on the plate: 200, sd about 13.
+    assert!((n - 200.0).abs() < 50.0, "{n} strikes");
+    let (fastest, slowest) = (
+        terminal_speed_m_per_s(DropKind::Hail, 0.020),
+        terminal_speed_m_per_s(DropKind::Hail, 0.005),
+    );
+    for e in a.events() {
+        let impact = e.impact.unwrap();
+        let s = impact.speed_m_per_s;
+        assert!(s >= slowest * 0.999 && s <= fastest * 1.001, "{s} m/s");
+        // From 4.995 m up, at that speed; let go between 1 and 3 s.
+        let fall_s = 4.995 / s;
+        assert!(e.time_s >= 1.0 + fall_s - 1e-3 && e.time_s <= 3.0 + fall_s + 1e-3);
+        // The largest stones play loudest: the gain is the mass, the cube of the diameter.
+        assert!(
+            impact.gain_db <= 0.0 && impact.gain_db >= -36.2,
+            "{}",
+            impact.gain_db
+        );
+    }
+    assert_eq!(
+        a.events(),
+        source(1).events(),
+        "the same seed, the same hail"
+    );
+    assert_ne!(a.events(), source(2).events());
+    // Diameters given largest first are an error.
+    let bad = scene(1).replace(r#""seed": 1"#, r#""seed": 1, "diameter_mm": [20, 5]"#);
+    let got = problems(&bad);
+    assert!(
+        got.contains("emitters[0].diameter_mm: expected the smallest then the largest, 1 to 150 mm, found [20, 5]"),
+        "{got}"
+    );
+}
+
+#[test]
+fn a_render_is_cut_with_a_fade_or_ends_a_tail_after_its_last_sound() {
+    let objects = format!(r#"{{"name": "o", "bank": "{BAR}", "position": [0, 0, -1]}}"#);
+    let events = r#"{"time_s": 0.1, "object": "o", "impact": {"speed_m_per_s": 1}}"#;
+    let file = parse_scene_str(&scene_json(&objects, events, "stereo"), "t").unwrap();
+    let source = SceneSource::new(file, "t", |spec| {
+        modal_resonator::bank::factory::factory_bank(spec).ok_or_else(|| format!("no {spec}"))
+    })
+    .unwrap();
+    // Cut at 0.5 s while the bar rings: exactly that long, faded to nothing over 10 ms.
+    let cut = render_scene(&source, RATE, 0.5, |_| {});
+    assert!(cut.cut_short && cut.left.len() == RATE as usize / 2);
+    let n = cut.left.len();
+    assert!(cut.left[n - 1].abs() < 1e-6 && rms(&cut.left[n - 960..n - 480]) > 1e-4);
+    // Whole: it ends 0.1 s after its last sound, and streams to a sink what it makes in memory.
+    let whole = render_scene(&source, RATE, 60.0, |_| {});
+    let last = whole.left.iter().rposition(|&v| v != 0.0).unwrap();
+    assert_eq!(whole.left.len(), last + 1 + (0.1 * RATE as f64) as usize);
+    let mut streamed = Vec::new();
+    let summary = modal_resonator::scene::render_scene_to(
+        &source,
+        RATE,
+        60.0,
+        |_| {},
+        |l, _| {
+            streamed.extend_from_slice(l);
+            Ok::<(), ()>(())
+        },
+    )
+    .unwrap();
+    assert_eq!(streamed, whole.left);
+    assert_eq!(summary.len, whole.left.len());
 }

@@ -7,7 +7,7 @@ use clap::Args;
 
 use modal_resonator::bank::staged::StagedFile;
 use modal_resonator::render::{BitDepth, WavFile};
-use modal_resonator::scene::{render_scene, SceneSource};
+use modal_resonator::scene::{render_scene_to, SceneSource};
 
 use super::check_output;
 use super::progress::Progress;
@@ -63,15 +63,20 @@ pub(super) fn run(args: &SceneArgs) -> Result<(), String> {
     let (steps, physics_s) = source.physics_cost();
     let started = Instant::now();
     let mut progress = Progress::new("rendering");
-    let rendered = render_scene(&source, args.rate, args.max_seconds, |d| progress.set(d));
-    progress.finish();
-    let elapsed_s = started.elapsed().as_secs_f64();
     let mut file =
         WavFile::create(&args.output, args.bits, args.rate).map_err(|e| e.to_string())?;
-    file.write(&rendered.left, &rendered.right)
-        .map_err(|e| e.to_string())?;
+    let rendered = render_scene_to(
+        &source,
+        args.rate,
+        args.max_seconds,
+        |d| progress.set(d),
+        |l, r| file.write(l, r),
+    )
+    .map_err(|e| e.to_string())?;
+    progress.finish();
+    let elapsed_s = started.elapsed().as_secs_f64();
     let events = match &args.events {
-        Some(path) => Some(stage_events(&source, path)?),
+        Some(path) => Some(stage_events(&source, path, args.max_seconds)?),
         None => None,
     };
     file.finish().map_err(|e| e.to_string())?;
@@ -80,12 +85,8 @@ pub(super) fn run(args: &SceneArgs) -> Result<(), String> {
             .commit()
             .map_err(|e| format!("--events {}: {e}", args.events.as_ref().unwrap().display()))?;
     }
-    let seconds = rendered.left.len() as f64 / args.rate as f64;
-    let peak = rendered
-        .left
-        .iter()
-        .chain(&rendered.right)
-        .fold(0.0f32, |a, v| a.max(v.abs()));
+    let seconds = rendered.len as f64 / args.rate as f64;
+    let peak = rendered.peak;
     let s = rendered.stats;
     println!(
         "{}: {seconds:.2} s, {} Hz {}, peak {:+.1} dBFS; {} object{}, {} impact{}, {} contact{}; \
@@ -107,8 +108,15 @@ pub(super) fn run(args: &SceneArgs) -> Result<(), String> {
             ""
         },
     );
+    if source.events_capped() {
+        eprintln!(
+            "warning: the physics found more impacts than a scene may hold ({}); the later ones \
+             were left out",
+            modal_resonator::scene::format::MAX_EVENTS
+        );
+    }
     if steps > 0 {
-        let simulated_s = source.file.physics.map_or(0.0, |p| p.duration_s);
+        let simulated_s = source.file().physics.map_or(0.0, |p| p.duration_s);
         println!(
             "physics: {steps} steps ({simulated_s:.2} s) in {physics_s:.2} s ({:.1}x real time)",
             simulated_s / physics_s.max(1e-9)
@@ -124,10 +132,18 @@ pub(super) fn run(args: &SceneArgs) -> Result<(), String> {
     Ok(())
 }
 
-/// Writes every event of `source`, in time order, one JSON object a line, to a temporary file
+/// Writes every event of `source` before `max_seconds`, in time order, one JSON object a line, to a temporary file
 /// beside `path`; committing it puts it in place.
-fn stage_events(source: &SceneSource, path: &std::path::Path) -> Result<StagedFile, String> {
-    let mut events: Vec<_> = source.events().iter().collect();
+fn stage_events(
+    source: &SceneSource,
+    path: &std::path::Path,
+    max_seconds: f64,
+) -> Result<StagedFile, String> {
+    let mut events: Vec<_> = source
+        .events()
+        .iter()
+        .filter(|e| e.time_s < max_seconds)
+        .collect();
     events.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
     let mut text = String::new();
     for e in events {

@@ -26,6 +26,10 @@ pub const MAX_OBJECTS: usize = 10_000;
 /// Most events in a scene.
 pub const MAX_EVENTS: usize = 1_000_000;
 
+/// Longest time all of a scene's contacts may last together, in seconds (each is followed
+/// every 2 ms).
+pub const MAX_CONTACT_S: f64 = 3600.0;
+
 /// Latest time an event may be given at, in seconds (an hour).
 pub const MAX_EVENT_TIME_S: f64 = 3600.0;
 
@@ -64,6 +68,69 @@ pub struct SceneFile {
     /// too; none without it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub physics: Option<Physics>,
+    /// Hail or rain falling on the bodies.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub emitters: Vec<Emitter>,
+}
+
+/// Drops falling on the scene (seed 001's hail): from random points of a horizontal rectangle,
+/// at random times (a Poisson process), each falls straight down at its terminal speed and
+/// strikes the first body under it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Emitter {
+    /// What falls.
+    pub kind: DropKind,
+    /// Centre of the rectangle the drops fall from, metres.
+    pub centre: [f64; 3],
+    /// Half the rectangle's size along x and z, metres.
+    pub half_extents_m: [f64; 2],
+    /// Drops a second, on average.
+    pub rate_per_s: f64,
+    /// When the first may fall, seconds (default 0).
+    #[serde(default)]
+    pub start_s: f64,
+    /// How long they fall, seconds.
+    pub duration_s: f64,
+    /// Smallest and largest diameter, mm, drawn uniformly on a log scale (default 5 to 20 for
+    /// hail, 0.5 to 4 for rain).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub diameter_mm: Option<[f64; 2]>,
+    /// Seed of the draws: the same seed, the same drops.
+    #[serde(default = "one_u32")]
+    pub seed: u32,
+}
+
+fn one_u32() -> u32 {
+    1
+}
+
+/// What an emitter drops.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum DropKind {
+    /// Hailstones: ice, 900 kg/m³.
+    Hail,
+    /// Raindrops: water, 1000 kg/m³.
+    Rain,
+}
+
+impl DropKind {
+    /// The diameters drawn when none are given, mm.
+    pub fn default_diameter_mm(self) -> [f64; 2] {
+        match self {
+            DropKind::Hail => [5.0, 20.0],
+            DropKind::Rain => [0.5, 4.0],
+        }
+    }
+
+    /// The diameters a scene may give, mm.
+    pub fn diameter_range_mm(self) -> (f64, f64) {
+        match self {
+            DropKind::Hail => (1.0, 150.0),
+            DropKind::Rain => (0.1, 8.0),
+        }
+    }
 }
 
 /// How long and how finely the objects' bodies are simulated.
@@ -204,6 +271,21 @@ pub struct SceneEvent {
 pub struct Impact {
     /// Relative normal speed at the contact, m/s.
     pub speed_m_per_s: f64,
+    /// Level of this impact over what its speed gives, dB, -120 to 40 (default 0): a lighter
+    /// striker's impulse is smaller at the same speed.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub gain_db: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+impl Impact {
+    /// Its strength: the speed, scaled by its gain.
+    pub fn strength(&self) -> f64 {
+        self.speed_m_per_s * 10f64.powf(self.gain_db / 20.0)
+    }
 }
 
 /// A persistent contact (scrape, roll or rub: the object's exciter, chosen with its `set`), its
@@ -392,6 +474,14 @@ pub fn validate(scene: &SceneFile) -> Vec<Problem> {
         }
         if let Some(body) = &o.body {
             check_body(body, &at("body"), &mut add);
+            if body.dynamic && o.bank.is_some() {
+                add(
+                    at("bank"),
+                    "a dynamic body cannot sound yet (it would be heard where it started); \
+                     give the bank to the fixed bodies it strikes"
+                        .into(),
+                );
+            }
         }
         check_point(&o.position, &at("position"), &mut add);
         if !(SCALE_RANGE.0..=SCALE_RANGE.1).contains(&o.scale) {
@@ -409,6 +499,17 @@ pub fn validate(scene: &SceneFile) -> Vec<Problem> {
                 format!("expected -60 to 40 dB, found {}", o.gain_db),
             );
         }
+    }
+    let contact_s: f64 = scene
+        .events
+        .iter()
+        .filter_map(|e| e.contact.map(|c| c.duration_s))
+        .sum();
+    if contact_s > MAX_CONTACT_S {
+        add(
+            "events".into(),
+            format!("contacts last {contact_s:.0} s in all, at most {MAX_CONTACT_S} s in a scene"),
+        );
     }
     // Whether each object has a bank, by name.
     let sounds: HashMap<&str, bool> = scene
@@ -510,6 +611,20 @@ pub fn validate(scene: &SceneFile) -> Vec<Problem> {
             }
         }
     }
+    for (i, e) in scene.emitters.iter().enumerate() {
+        check_emitter(e, &format!("emitters[{i}]"), &mut add);
+    }
+    let drops: f64 = scene
+        .emitters
+        .iter()
+        .map(|e| e.rate_per_s * e.duration_s)
+        .sum();
+    if drops > MAX_EVENTS as f64 {
+        add(
+            "emitters".into(),
+            format!("{drops:.0} drops on average, at most {MAX_EVENTS} in a scene"),
+        );
+    }
     let l = &scene.listener;
     check_point(&l.position, "listener.position", &mut add);
     let f = l.forward;
@@ -532,6 +647,54 @@ fn check_point(p: &[f64; 3], path: &str, add: &mut impl FnMut(String, String)) {
             add(
                 format!("{path}[{k}]"),
                 format!("expected metres within {MAX_COORDINATE_M} of the origin, found {v}"),
+            );
+        }
+    }
+}
+
+/// Checks an emitter: its rectangle, rate, times and diameters.
+fn check_emitter(e: &Emitter, path: &str, add: &mut impl FnMut(String, String)) {
+    check_point(&e.centre, &format!("{path}.centre"), add);
+    for (k, h) in e.half_extents_m.iter().enumerate() {
+        if !(0.0..=MAX_COORDINATE_M).contains(h) {
+            add(
+                format!("{path}.half_extents_m[{k}]"),
+                format!("expected 0 to {MAX_COORDINATE_M} m, found {h}"),
+            );
+        }
+    }
+    if !(e.rate_per_s > 0.0 && e.rate_per_s <= 1e5) {
+        add(
+            format!("{path}.rate_per_s"),
+            format!(
+                "expected over 0 up to 100000 a second, found {}",
+                e.rate_per_s
+            ),
+        );
+    }
+    if !(0.0..=MAX_EVENT_TIME_S).contains(&e.start_s) {
+        add(
+            format!("{path}.start_s"),
+            format!("expected 0 to {MAX_EVENT_TIME_S} s, found {}", e.start_s),
+        );
+    }
+    if !(e.duration_s > 0.0 && e.duration_s <= MAX_EVENT_TIME_S) {
+        add(
+            format!("{path}.duration_s"),
+            format!(
+                "expected over 0 up to {MAX_EVENT_TIME_S} s, found {}",
+                e.duration_s
+            ),
+        );
+    }
+    if let Some([lo, hi]) = e.diameter_mm {
+        let (min, max) = e.kind.diameter_range_mm();
+        if !((min..=max).contains(&lo) && (lo..=max).contains(&hi)) {
+            add(
+                format!("{path}.diameter_mm"),
+                format!(
+                    "expected the smallest then the largest, {min} to {max} mm, found [{lo}, {hi}]"
+                ),
             );
         }
     }

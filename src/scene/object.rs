@@ -71,6 +71,8 @@ struct Part {
     events: Vec<TimedEvent>,
     /// The next event not yet played.
     next: usize,
+    /// Gain of its output.
+    gain: f32,
 }
 
 /// An object as it sounds at the listener.
@@ -93,11 +95,12 @@ pub(super) struct SoundingObject {
 }
 
 impl SoundingObject {
-    /// An object playing `bank`, each of `parts` with its controls and its events timed where
-    /// they happen (shifted here by the travel time), heard as `placement` says through `gain`.
+    /// An object playing `bank`, each of `parts` with its controls, its events timed where
+    /// they happen (shifted here by the travel time) and its gain, heard as `placement` says
+    /// through `gain`. `max_block` is at least 1.
     pub fn new(
         bank: &Arc<PreparedBank>,
-        parts: Vec<(Controls, Vec<TimedEvent>)>,
+        parts: Vec<(Controls, Vec<TimedEvent>, f64)>,
         placement: &Placement,
         gain: f64,
         sample_rate_hz: f64,
@@ -107,7 +110,7 @@ impl SoundingObject {
         let shift = delays[0].min(delays[1]).floor().max(0.0) as u64;
         let parts: Vec<Part> = parts
             .into_iter()
-            .map(|(controls, mut events)| {
+            .map(|(controls, mut events, part_gain)| {
                 let mut engine = Engine::new(Arc::clone(bank));
                 engine.set_controls(&controls);
                 engine.reserve_voices(controls.polyphony);
@@ -119,6 +122,7 @@ impl SoundingObject {
                     engine,
                     events,
                     next: 0,
+                    gain: part_gain as f32,
                 }
             })
             .collect();
@@ -145,8 +149,8 @@ impl SoundingObject {
     }
 
     /// Adds its next `left.len()` samples at the listener to `left` and `right`, the block
-    /// starting at sample `start`. Allocates only when a block holds more events than any
-    /// before.
+    /// starting at sample `start`. Never allocates: the events of a block fit the storage
+    /// sized for the fullest block.
     pub fn add_to(&mut self, start: u64, left: &mut [f32], right: &mut [f32]) {
         if self.done {
             return;
@@ -178,7 +182,7 @@ impl SoundingObject {
             pr.fill(0.0);
             part.engine.process(&self.block_events, None, pl, pr);
             for (o, &x) in l.iter_mut().zip(pl.iter()) {
-                *o += x;
+                *o += part.gain * x;
             }
             silent &= part.next == part.events.len() && part.engine.is_silent();
         }

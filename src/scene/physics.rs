@@ -12,12 +12,13 @@ use std::collections::HashSet;
 use rapier3d::math::{Pose, Vector};
 use rapier3d::parry::query;
 use rapier3d::prelude::{
-    ColliderBuilder, ColliderHandle, PairContacts, PhysicsWorld, RigidBodyBuilder, RigidBodyHandle,
-    SharedShape,
+    ColliderBuilder, ColliderHandle, PairContacts, PhysicsWorld, QueryFilter, Ray,
+    RigidBodyBuilder, RigidBodyHandle, SharedShape,
 };
 
-use super::format::{Body, Collider, Impact, SceneEvent, SceneFile};
+use super::format::{Body, Collider, DropKind, Emitter, Impact, SceneEvent, SceneFile, MAX_EVENTS};
 use crate::bank::validate::Problem;
+use crate::rng::Rng;
 
 /// Slowest impact struck, m/s: 40 dB under an impact at 1 m/s.
 pub const MIN_IMPACT_M_PER_S: f64 = 0.01;
@@ -36,6 +37,9 @@ pub struct Simulated {
     pub events: Vec<SceneEvent>,
     /// Steps taken.
     pub steps: usize,
+    /// Whether more impacts were found than a scene may hold ([`MAX_EVENTS`]); the later ones
+    /// are left out.
+    pub capped: bool,
 }
 
 fn vector(v: [f64; 3]) -> Vector {
@@ -111,11 +115,10 @@ pub fn check_places(scene: &SceneFile) -> Vec<Problem> {
 /// Builds the world: one rigid body per object with a `body`, its index in `user_data`.
 fn build(scene: &SceneFile) -> (PhysicsWorld, Vec<(usize, RigidBodyHandle)>) {
     let mut world = PhysicsWorld::default();
-    let physics = scene
-        .physics
-        .expect("only scenes with physics are simulated");
-    world.gravity = vector(physics.gravity_m_per_s2);
-    world.integration_parameters.dt = physics.step_s as f32;
+    if let Some(physics) = scene.physics {
+        world.gravity = vector(physics.gravity_m_per_s2);
+        world.integration_parameters.dt = physics.step_s as f32;
+    }
     let mut handles = Vec::new();
     for (i, o) in scene.objects.iter().enumerate() {
         let Some(b) = &o.body else { continue };
@@ -160,10 +163,28 @@ impl Motion {
     }
 }
 
-/// Runs the scene's physics for its duration and returns the impacts on objects that sound.
+/// Runs the scene's physics for its duration, and its emitters' drops, and returns the impacts
+/// on objects that sound.
 pub fn simulate(scene: &SceneFile) -> Simulated {
-    let Some(physics) = scene.physics else {
+    if scene.physics.is_none() && scene.emitters.is_empty() {
         return Simulated::default();
+    }
+    let drops = drops(&scene.emitters);
+    let Some(physics) = scene.physics else {
+        // Nothing moves: every drop is cast against the bodies where they stand.
+        let (mut world, _) = build(scene);
+        world.detect_collisions(&(), &());
+        let mut events = Vec::new();
+        for d in &drops {
+            cast(&world, scene, d, &mut events);
+        }
+        events.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+        let capped = cap(&mut events, scene.events.len());
+        return Simulated {
+            events,
+            steps: 0,
+            capped,
+        };
     };
     let (mut world, handles) = build(scene);
     let steps = (physics.duration_s / physics.step_s).round() as usize;
@@ -171,7 +192,17 @@ pub fn simulate(scene: &SceneFile) -> Simulated {
     let mut touching: HashSet<(ColliderHandle, ColliderHandle)> = HashSet::new();
     let mut now_touching = HashSet::new();
     let mut events = Vec::new();
+    let mut next_drop = 0;
     for step in 0..steps {
+        if events.len() > MAX_EVENTS {
+            break;
+        }
+        // Drops let go before this step ends fall on the bodies where they stand now.
+        let step_end_s = (step + 1) as f64 * physics.step_s;
+        while next_drop < drops.len() && drops[next_drop].time_s < step_end_s {
+            cast(&world, scene, &drops[next_drop], &mut events);
+            next_drop += 1;
+        }
         for &(i, h) in &handles {
             let b = &world.bodies[h];
             motions[i] = Some(Motion {
@@ -236,6 +267,7 @@ pub fn simulate(scene: &SceneFile) -> Simulated {
                         object: scene.objects[o].name.clone(),
                         impact: Some(Impact {
                             speed_m_per_s: closing.min(super::format::MAX_SPEED_M_PER_S),
+                            gain_db: 0.0,
                         }),
                         contact: None,
                     });
@@ -244,5 +276,104 @@ pub fn simulate(scene: &SceneFile) -> Simulated {
         }
         std::mem::swap(&mut touching, &mut now_touching);
     }
-    Simulated { events, steps }
+    events.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+    let capped = cap(&mut events, scene.events.len());
+    Simulated {
+        events,
+        steps,
+        capped,
+    }
+}
+
+/// Keeps the earliest of `events` that fit beside `given` events within [`MAX_EVENTS`];
+/// returns whether any were left out.
+fn cap(events: &mut Vec<SceneEvent>, given: usize) -> bool {
+    let room = MAX_EVENTS.saturating_sub(given);
+    let capped = events.len() > room;
+    events.truncate(room);
+    capped
+}
+
+/// Drag coefficient of a hailstone, a rough sphere (the drag equation's `C_d`).
+const HAIL_DRAG: f64 = 0.6;
+
+/// Density of hail (ice with air in it) and of air, kg/m³.
+const HAIL_DENSITY: f64 = 900.0;
+const AIR_DENSITY: f64 = 1.2;
+
+/// Terminal speed of a drop, m/s: for hail the drag equation, `v = sqrt(4 g d rho_ice /
+/// (3 C_d rho_air))` (13 m/s for 1 cm); for rain Atlas, Srivastava and Sekhon (1973),
+/// `v = 9.65 - 10.3 exp(-0.6 d)` with `d` in mm (6.5 m/s for 2 mm).
+pub fn terminal_speed_m_per_s(kind: DropKind, diameter_m: f64) -> f64 {
+    match kind {
+        DropKind::Hail => {
+            (4.0 * 9.81 * diameter_m * HAIL_DENSITY / (3.0 * HAIL_DRAG * AIR_DENSITY)).sqrt()
+        }
+        DropKind::Rain => (9.65 - 10.3 * (-0.6 * diameter_m * 1e3).exp()).max(0.1),
+    }
+}
+
+/// One drop: when it is let go, where, how large, how fast.
+#[derive(Debug, Clone, Copy)]
+struct Drop {
+    time_s: f64,
+    at: [f64; 3],
+    speed_m_per_s: f64,
+    /// Its level against the largest drop its emitter can let go: its mass, the cube of its
+    /// diameter, at the same speed (the impulse).
+    gain_db: f64,
+}
+
+/// Every emitter's drops, in time order: Poisson arrivals at the rate, points uniform over the
+/// rectangle, diameters uniform on a log scale.
+fn drops(emitters: &[Emitter]) -> Vec<Drop> {
+    let mut drops = Vec::new();
+    for e in emitters {
+        let mut rng = Rng::new(e.seed);
+        let [lo, hi] = e.diameter_mm.unwrap_or(e.kind.default_diameter_mm());
+        let mut t = e.start_s;
+        loop {
+            // 1 - u lies in (0, 1]: its logarithm is finite.
+            t += -(1.0 - rng.uniform()).ln() / e.rate_per_s;
+            if t >= e.start_s + e.duration_s {
+                break;
+            }
+            let x = e.centre[0] + e.half_extents_m[0] * (2.0 * rng.uniform() - 1.0);
+            let z = e.centre[2] + e.half_extents_m[1] * (2.0 * rng.uniform() - 1.0);
+            let d_mm = lo * (hi / lo).powf(rng.uniform());
+            drops.push(Drop {
+                time_s: t,
+                at: [x, e.centre[1], z],
+                speed_m_per_s: terminal_speed_m_per_s(e.kind, d_mm * 1e-3),
+                gain_db: 60.0 * (d_mm / hi).log10(),
+            });
+        }
+    }
+    drops.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
+    drops
+}
+
+/// Casts a drop straight down; if it lands on an object that sounds, strikes it there at the
+/// drop's speed along the surface's normal.
+fn cast(world: &PhysicsWorld, scene: &SceneFile, d: &Drop, events: &mut Vec<SceneEvent>) {
+    let ray = Ray::new(vector(d.at), Vector::new(0.0, -1.0, 0.0));
+    let hit = world.cast_ray_and_get_normal(&ray, 1e6, true, QueryFilter::default());
+    let Some((collider, hit)) = hit else { return };
+    let Some(parent) = world.colliders[collider].parent() else {
+        return;
+    };
+    let object = &scene.objects[world.bodies[parent].user_data as usize];
+    let speed = d.speed_m_per_s * hit.normal.y.abs() as f64;
+    if object.bank.is_none() || speed < MIN_IMPACT_M_PER_S {
+        return;
+    }
+    events.push(SceneEvent {
+        time_s: d.time_s + hit.time_of_impact as f64 / d.speed_m_per_s,
+        object: object.name.clone(),
+        impact: Some(Impact {
+            speed_m_per_s: speed,
+            gain_db: d.gain_db,
+        }),
+        contact: None,
+    });
 }
