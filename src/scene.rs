@@ -25,6 +25,7 @@ pub mod format;
 pub mod listener;
 mod object;
 pub mod physics;
+pub mod validate;
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -116,7 +117,7 @@ impl SceneSource {
             origin: origin.to_string(),
             problems,
         };
-        let problems = format::validate(&file);
+        let problems = validate::validate(&file);
         if !problems.is_empty() {
             return Err(invalid(problems));
         }

@@ -7,7 +7,7 @@ use clap::Args;
 
 use modal_resonator::bank::staged::StagedFile;
 use modal_resonator::render::{BitDepth, WavFile};
-use modal_resonator::scene::{render_scene_to, SceneSource};
+use modal_resonator::scene::{render_scene_to, SceneSource, SceneSummary};
 
 use super::check_output;
 use super::progress::Progress;
@@ -60,7 +60,6 @@ pub(super) fn run(args: &SceneArgs) -> Result<(), String> {
         }
     }
     let source = SceneSource::from_file(&args.scene).map_err(|e| e.to_string())?;
-    let (steps, physics_s) = source.physics_cost();
     let started = Instant::now();
     let mut progress = Progress::new("rendering");
     let mut file =
@@ -85,6 +84,13 @@ pub(super) fn run(args: &SceneArgs) -> Result<(), String> {
             .commit()
             .map_err(|e| format!("--events {}: {e}", args.events.as_ref().unwrap().display()))?;
     }
+    report(args, &source, &rendered, elapsed_s);
+    Ok(())
+}
+
+/// Prints what was rendered, and warns of left-out impacts and clipping.
+fn report(args: &SceneArgs, source: &SceneSource, rendered: &SceneSummary, elapsed_s: f64) {
+    let (steps, physics_s) = source.physics_cost();
     let seconds = rendered.len as f64 / args.rate as f64;
     let peak = rendered.peak;
     let s = rendered.stats;
@@ -129,11 +135,10 @@ pub(super) fn run(args: &SceneArgs) -> Result<(), String> {
             args.bits.name()
         );
     }
-    Ok(())
 }
 
-/// Writes every event of `source` before `max_seconds`, in time order, one JSON object a line, to a temporary file
-/// beside `path`; committing it puts it in place.
+/// Writes every event of `source` before `max_seconds`, in time order, one JSON object a line,
+/// to a temporary file beside `path`; committing it puts it in place.
 fn stage_events(
     source: &SceneSource,
     path: &std::path::Path,

@@ -213,67 +213,15 @@ pub fn simulate(scene: &SceneFile) -> Simulated {
         }
         world.step();
         let step_start_s = step as f64 * physics.step_s;
+        let step_s = physics.step_s;
+        let after = Step {
+            start_s: step_start_s,
+            step_s,
+            motions: &motions,
+            touching: &touching,
+        };
         now_touching.clear();
-        for pair in world.narrow_phase.contact_pairs() {
-            let PairContacts::Rigid(contacts) = &pair.contacts else {
-                continue;
-            };
-            // The point that took the largest impulse, its manifold's normal, and the gap there
-            // when the step began.
-            let mut hit: Option<(Vector, Vector, f32)> = None;
-            let mut most = 0.0f32;
-            for m in contacts.solver_manifolds() {
-                for p in &m.points {
-                    if p.data.impulse > most {
-                        most = p.data.impulse;
-                        let c1 = &world.colliders[pair.collider1];
-                        let at = c1.position().transform_point(p.local_p1);
-                        hit = Some((at, m.data.normal, p.dist));
-                    }
-                }
-            }
-            let Some((point, normal, gap)) = hit else {
-                continue;
-            };
-            let key = (pair.collider1, pair.collider2);
-            now_touching.insert(key);
-            let object = |c: ColliderHandle| {
-                let parent = world.colliders[c].parent()?;
-                Some(world.bodies[parent].user_data as usize)
-            };
-            let (Some(o1), Some(o2)) = (object(pair.collider1), object(pair.collider2)) else {
-                continue;
-            };
-            let velocity = |o: usize| motions[o].map_or(Vector::ZERO, |m| m.at(point));
-            let closing = ((velocity(o1) - velocity(o2)).dot(normal)) as f64;
-            let threshold = if touching.contains(&key) {
-                RESTRIKE_M_PER_S
-            } else {
-                MIN_IMPACT_M_PER_S
-            };
-            if closing < threshold {
-                continue;
-            }
-            // When the gap closed: the contacts are found at the start of the step, the gap
-            // then negative if the bodies already overlapped (they moved through it in the
-            // step before) or positive if they meet within this one.
-            let time_s = (step_start_s + gap as f64 / closing)
-                .clamp(step_start_s - physics.step_s, step_start_s + physics.step_s)
-                .max(0.0);
-            for o in [o1, o2] {
-                if scene.objects[o].bank.is_some() {
-                    events.push(SceneEvent {
-                        time_s,
-                        object: scene.objects[o].name.clone(),
-                        impact: Some(Impact {
-                            speed_m_per_s: closing.min(super::format::MAX_SPEED_M_PER_S),
-                            gain_db: 0.0,
-                        }),
-                        contact: None,
-                    });
-                }
-            }
-        }
+        strikes_of_step(&world, scene, &after, &mut now_touching, &mut events);
         std::mem::swap(&mut touching, &mut now_touching);
     }
     events.sort_by(|a, b| a.time_s.total_cmp(&b.time_s));
@@ -282,6 +230,87 @@ pub fn simulate(scene: &SceneFile) -> Simulated {
         events,
         steps,
         capped,
+    }
+}
+
+/// A step just taken: when it began, how long it was, the bodies' motions before it, and the
+/// pairs that touched the step before.
+struct Step<'a> {
+    start_s: f64,
+    step_s: f64,
+    motions: &'a [Option<Motion>],
+    touching: &'a HashSet<(ColliderHandle, ColliderHandle)>,
+}
+
+/// The strikes of the step `after` describes: every pair whose manifolds took an impulse is
+/// noted in `now_touching`; a pair that touches anew closing at [`MIN_IMPACT_M_PER_S`] or more,
+/// or one in touch closing at [`RESTRIKE_M_PER_S`], strikes each of its bodies that sounds.
+fn strikes_of_step(
+    world: &PhysicsWorld,
+    scene: &SceneFile,
+    after: &Step,
+    now_touching: &mut HashSet<(ColliderHandle, ColliderHandle)>,
+    events: &mut Vec<SceneEvent>,
+) {
+    for pair in world.narrow_phase.contact_pairs() {
+        let PairContacts::Rigid(contacts) = &pair.contacts else {
+            continue;
+        };
+        // The point that took the largest impulse, its manifold's normal, and the gap there
+        // when the step began.
+        let mut hit: Option<(Vector, Vector, f32)> = None;
+        let mut most = 0.0f32;
+        for m in contacts.solver_manifolds() {
+            for p in &m.points {
+                if p.data.impulse > most {
+                    most = p.data.impulse;
+                    let c1 = &world.colliders[pair.collider1];
+                    let at = c1.position().transform_point(p.local_p1);
+                    hit = Some((at, m.data.normal, p.dist));
+                }
+            }
+        }
+        let Some((point, normal, gap)) = hit else {
+            continue;
+        };
+        let key = (pair.collider1, pair.collider2);
+        now_touching.insert(key);
+        let object = |c: ColliderHandle| {
+            let parent = world.colliders[c].parent()?;
+            Some(world.bodies[parent].user_data as usize)
+        };
+        let (Some(o1), Some(o2)) = (object(pair.collider1), object(pair.collider2)) else {
+            continue;
+        };
+        let velocity = |o: usize| after.motions[o].map_or(Vector::ZERO, |m| m.at(point));
+        let closing = ((velocity(o1) - velocity(o2)).dot(normal)) as f64;
+        let threshold = if after.touching.contains(&key) {
+            RESTRIKE_M_PER_S
+        } else {
+            MIN_IMPACT_M_PER_S
+        };
+        if closing < threshold {
+            continue;
+        }
+        // When the gap closed: the contacts are found at the start of the step, the gap
+        // then negative if the bodies already overlapped (they moved through it in the
+        // step before) or positive if they meet within this one.
+        let time_s = (after.start_s + gap as f64 / closing)
+            .clamp(after.start_s - after.step_s, after.start_s + after.step_s)
+            .max(0.0);
+        for o in [o1, o2] {
+            if scene.objects[o].bank.is_some() {
+                events.push(SceneEvent {
+                    time_s,
+                    object: scene.objects[o].name.clone(),
+                    impact: Some(Impact {
+                        speed_m_per_s: closing.min(super::format::MAX_SPEED_M_PER_S),
+                        gain_db: 0.0,
+                    }),
+                    contact: None,
+                });
+            }
+        }
     }
 }
 
