@@ -26,22 +26,21 @@ fn row(name: &str, make: impl Fn() -> SceneSource, repeats: usize) {
         let r = render_scene(&source, RATE, 120.0, |_| {});
         best_audio = best_audio.min(start.elapsed().as_secs_f64());
         let simulated_s = source.file().physics.map_or(0.0, |p| p.duration_s);
-        row = Some((
-            r.stats,
-            steps,
-            simulated_s,
-            r.left.len() as f64 / RATE as f64,
-        ));
+        let used = !source.file().emitters.is_empty();
+        let audio_s = r.left.len() as f64 / RATE as f64;
+        row = Some((r.stats, steps, simulated_s, audio_s, used));
     }
-    let (stats, steps, simulated_s, audio_s) = row.expect("at least one run");
+    let (stats, steps, simulated_s, audio_s, physics_used) = row.expect("at least one run");
     let physics = if steps > 0 {
         format!(
             "{steps} steps ({simulated_s:.1} s) in {:.1} ms: {:.0}x real time",
             1e3 * best_physics,
             simulated_s / best_physics
         )
-    } else {
+    } else if physics_used {
         format!("drops cast in {:.1} ms", 1e3 * best_physics)
+    } else {
+        "none".to_string()
     };
     println!(
         "{name:<28} {:>5} objects {:>6} impacts | physics: {physics} | audio: {audio_s:.1} s in \
