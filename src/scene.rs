@@ -1,9 +1,10 @@
 //! Scenes: many objects, each a bank placed in space, sounded by timed impacts and contacts and
 //! heard from one listener's place (seed 001 sections 4-5, seed 003, seed 004).
 //!
-//! A scene file ([`format`]) names the objects, the events and the listener. Each object plays
-//! its bank through an engine of its own (two when it is both struck and scraped: the exciter is
-//! an engine's); the listener ([`listener`]) hears it through
+//! A scene file ([`format`]) names the objects, the events and the listener; the rigid bodies'
+//! impacts ([`physics`], by rapier3d) and hail or rain from emitters are events too. Each
+//! object plays its bank through an engine of its own (two when it is both struck and scraped:
+//! the exciter is an engine's); the listener ([`listener`]) hears it through
 //!
 //! - a distance gain, `1/r` re 1 m, held at its value at [`listener::NEAR_M`] closer in;
 //! - the air's absorption over that distance (ISO 9613-1), a gain per mode, since it depends on
@@ -11,15 +12,16 @@
 //! - the time sound takes to arrive, and its direction: equal-power stereo by azimuth, or a
 //!   spherical head's two ears (Brown and Duda 1998: each ear's delay and head shadow).
 //!
-//! Objects and the listener stand still, so the arrival time shifts each object's events, whole
-//! samples, and only the fraction of a sample and the ears' difference pass through a delay
-//! line.
+//! Sounding objects and the listener stand still (a dynamic body cannot have a bank yet), so the
+//! arrival time shifts each object's events, whole samples, and only the fraction of a sample
+//! and the ears' difference pass through a delay line.
 //!
 //! An impact's loudness is proportional to its relative normal speed (seed 004 takes the
 //! impulse, `m u`): each object's strikes play at velocity `speed / s_ref` with a linear velocity
-//! curve and its output is scaled by `s_ref`, the fastest impact on it (at least 1 m/s), so an
-//! impact twice as fast is 6 dB louder wherever it falls. The velocity's effect on hardness is
-//! off unless the object's `set` turns it on (`velocity_to_hardness`).
+//! curve and their output is scaled by `s_ref`, the strongest impact on it (at least 1 m/s), so
+//! an impact twice as fast is 6 dB louder wherever it falls; its contacts play apart, at the
+//! level their force curves give. The velocity's effect on hardness is off unless the object's
+//! `set` turns it on (`velocity_to_hardness`).
 
 pub mod format;
 pub mod listener;
