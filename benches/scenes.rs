@@ -9,7 +9,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use modal_resonator::bank::factory::factory_bank;
-use modal_resonator::scene::{parse_scene_str, render_scene, SceneSource};
+use modal_resonator::scene::{render_scene, SceneSource};
 
 const RATE: u32 = 48_000;
 
@@ -108,13 +108,7 @@ fn main() {
     }
     if full {
         let text = large(1000);
-        let make = || {
-            let file = parse_scene_str(&text, "large").unwrap();
-            SceneSource::new(file, "large", |s| {
-                factory_bank(s).ok_or_else(|| s.to_string())
-            })
-            .unwrap()
-        };
+        let make = || SceneSource::from_str(&text, "large", &dir).unwrap();
         let modes: usize = (0..1000)
             .map(|i| {
                 let bank = [

@@ -103,9 +103,15 @@ impl SceneSource {
                 message: format!("cannot read the scene: {e}"),
             }],
         })?;
-        let file = parse_scene_str(&text, &origin)?;
         let dir = path.parent().unwrap_or(Path::new("."));
-        Self::new(file, &origin, |spec| resolve_bank(spec, dir))
+        Self::from_str(&text, &origin, dir)
+    }
+
+    /// A scene from JSON text, its bank files found relative to `dir`; `origin` names the text
+    /// in errors.
+    pub fn from_str(text: &str, origin: &str, dir: &Path) -> Result<Self, SceneError> {
+        let file = parse_scene_str(text, origin)?;
+        Self::new(file, origin, |spec| resolve_bank(spec, dir))
     }
 
     /// `file` with each object's bank from `resolve` (given the object's `bank`); `origin` names

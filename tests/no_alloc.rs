@@ -234,7 +234,7 @@ fn pruning_and_the_budget_never_allocate() {
 
 #[test]
 fn a_scene_steps_without_allocating() {
-    use modal_resonator::scene::{parse_scene_str, Scene, SceneSource};
+    use modal_resonator::scene::{Scene, SceneSource};
     // Objects struck, scraped and simulated, heard binaurally, stepped in blocks of mixed sizes.
     let text = r#"{"format": "modal-scene", "version": 1,
         "objects": [
@@ -250,11 +250,7 @@ fn a_scene_steps_without_allocating() {
            "contact": {"duration_s": 0.5, "speed_m_per_s": [0.2, 1], "force": [0.5, 0.5]}}],
         "physics": {"duration_s": 1.5},
         "listener": {"position": [0, 1, 0], "output": "binaural"}}"#;
-    let file = parse_scene_str(text, "test").unwrap();
-    let source = SceneSource::new(file, "test", |spec| {
-        modal_resonator::bank::factory::factory_bank(spec).ok_or_else(|| format!("no {spec}"))
-    })
-    .unwrap();
+    let source = SceneSource::from_str(text, "test", std::path::Path::new(".")).unwrap();
     assert!(source.events().len() > 4, "the ball strikes the floor");
     let mut scene = Scene::new(&source, 48_000, 512);
     let (mut l, mut r) = (vec![0.0f32; 512], vec![0.0f32; 512]);

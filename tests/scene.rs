@@ -9,7 +9,7 @@ use std::process::Command;
 
 use modal_resonator::scene::format::MAX_OBJECTS;
 use modal_resonator::scene::listener::SPEED_OF_SOUND_M_PER_S;
-use modal_resonator::scene::{parse_scene_str, render_scene, scene_schema_json, SceneSource};
+use modal_resonator::scene::{render_scene, scene_schema_json, SceneSource};
 
 const RATE: u32 = 48_000;
 
@@ -22,13 +22,15 @@ fn scene_json(objects: &str, events: &str, output: &str) -> String {
     )
 }
 
+/// Scene text read and checked, its banks factory banks (or files beside the tests).
+fn source_of(text: &str, origin: &str) -> SceneSource {
+    SceneSource::from_str(text, origin, Path::new(env!("CARGO_MANIFEST_DIR")))
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
 /// Renders scene text whose banks are factory banks.
 fn render(text: &str) -> (Vec<f32>, Vec<f32>) {
-    let file = parse_scene_str(text, "test").unwrap_or_else(|e| panic!("{e}"));
-    let source = SceneSource::new(file, "test", |spec| {
-        modal_resonator::bank::factory::factory_bank(spec).ok_or_else(|| format!("no {spec}"))
-    })
-    .unwrap_or_else(|e| panic!("{e}"));
+    let source = source_of(text, "test");
     let r = render_scene(&source, RATE, 60.0, |_| {});
     assert!(!r.cut_short);
     (r.left, r.right)
@@ -203,14 +205,8 @@ fn a_scene_renders_the_same_twice() {
 
 /// The problems of scene text, one per line.
 fn problems(text: &str) -> String {
-    match parse_scene_str(text, "scene.json") {
-        Ok(file) => match SceneSource::new(file, "scene.json", |spec| {
-            modal_resonator::bank::factory::factory_bank(spec)
-                .ok_or_else(|| format!("no factory bank named \"{spec}\""))
-        }) {
-            Ok(_) => String::new(),
-            Err(e) => e.to_string(),
-        },
+    match SceneSource::from_str(text, "scene.json", Path::new(env!("CARGO_MANIFEST_DIR"))) {
+        Ok(_) => String::new(),
         Err(e) => e.to_string(),
     }
 }
@@ -423,11 +419,7 @@ fn dropped(height_m: f64, seconds: f64) -> (SceneSource, String) {
             "listener": {{"position": [0, 0.5, 0]}}}}"#,
         height_m + 0.02
     );
-    let file = parse_scene_str(&text, "drop").unwrap_or_else(|e| panic!("{e}"));
-    let source = SceneSource::new(file, "drop", |spec| {
-        modal_resonator::bank::factory::factory_bank(spec).ok_or_else(|| format!("no {spec}"))
-    })
-    .unwrap_or_else(|e| panic!("{e}"));
+    let source = source_of(&text, "drop");
     (source, text)
 }
 
@@ -550,11 +542,7 @@ fn a_box_resting_on_the_floor_never_strikes() {
            "body": {"dynamic": true, "collider": {"ball": {"radius_m": 0.02}}, "restitution": 0.2}}],
         "physics": {"duration_s": 3},
         "listener": {"position": [0, 1, 0]}}"#;
-    let file = parse_scene_str(text, "rest").unwrap();
-    let source = SceneSource::new(file, "rest", |spec| {
-        modal_resonator::bank::factory::factory_bank(spec).ok_or_else(|| format!("no {spec}"))
-    })
-    .unwrap();
+    let source = source_of(text, "rest");
     let times: Vec<f64> = source.events().iter().map(|e| e.time_s).collect();
     // The ball's bounces, from 0.5 m, all within the first second; nothing after.
     assert!(!times.is_empty() && times[0] > 0.25, "{times:?}");
@@ -598,13 +586,7 @@ fn hail_falls_at_its_rate_on_what_lies_under_it() {
                 "listener": {{"position": [0, 1, 0]}}}}"#
         )
     };
-    let source = |seed| {
-        let file = parse_scene_str(&scene(seed), "hail").unwrap_or_else(|e| panic!("{e}"));
-        SceneSource::new(file, "hail", |spec| {
-            modal_resonator::bank::factory::factory_bank(spec).ok_or_else(|| format!("no {spec}"))
-        })
-        .unwrap_or_else(|e| panic!("{e}"))
-    };
+    let source = |seed| source_of(&scene(seed), "hail");
     let a = source(1);
     let n = a.events().len() as f64;
     // 800 drops, a quarter on the plate: 200, sd about 13.
@@ -646,11 +628,7 @@ fn hail_falls_at_its_rate_on_what_lies_under_it() {
 fn a_render_is_cut_with_a_fade_or_ends_a_tail_after_its_last_sound() {
     let objects = format!(r#"{{"name": "o", "bank": "{BAR}", "position": [0, 0, -1]}}"#);
     let events = r#"{"time_s": 0.1, "object": "o", "impact": {"speed_m_per_s": 1}}"#;
-    let file = parse_scene_str(&scene_json(&objects, events, "stereo"), "t").unwrap();
-    let source = SceneSource::new(file, "t", |spec| {
-        modal_resonator::bank::factory::factory_bank(spec).ok_or_else(|| format!("no {spec}"))
-    })
-    .unwrap();
+    let source = source_of(&scene_json(&objects, events, "stereo"), "t");
     // Cut at 0.5 s while the bar rings: exactly that long, faded to nothing over 10 ms.
     let cut = render_scene(&source, RATE, 0.5, |_| {});
     assert!(cut.cut_short && cut.left.len() == RATE as usize / 2);

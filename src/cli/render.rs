@@ -321,7 +321,7 @@ fn parse_assignment(text: &str) -> Result<(String, String), String> {
 }
 
 /// Parses `--bits`.
-fn parse_bit_depth(text: &str) -> Result<BitDepth, String> {
+pub(super) fn parse_bit_depth(text: &str) -> Result<BitDepth, String> {
     text.parse::<u16>()
         .ok()
         .and_then(BitDepth::from_bits)

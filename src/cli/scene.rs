@@ -11,6 +11,7 @@ use modal_resonator::scene::{render_scene_to, SceneSource, SceneSummary};
 
 use super::check_output;
 use super::progress::Progress;
+use super::render::parse_bit_depth;
 
 /// Arguments of `scene`.
 #[derive(Debug, Args)]
@@ -33,14 +34,6 @@ pub(super) struct SceneArgs {
     /// in time order (when it happens at the object, which object, what).
     #[arg(long, value_name = "FILE")]
     events: Option<PathBuf>,
-}
-
-/// Parses `--bits`.
-fn parse_bit_depth(text: &str) -> Result<BitDepth, String> {
-    text.parse::<u16>()
-        .ok()
-        .and_then(BitDepth::from_bits)
-        .ok_or_else(|| format!("expected 16, 24 or 32, found \"{text}\""))
 }
 
 /// `scene`: the scene and every bank it names are read and checked before anything renders,

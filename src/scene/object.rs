@@ -159,7 +159,6 @@ impl SoundingObject {
         let end = start + len as u64;
         let (l, r) = (&mut self.left[..len], &mut self.right[..len]);
         l.fill(0.0);
-        r.fill(0.0);
         let mut silent = true;
         let mut sounded = false;
         for part in &mut self.parts {
