@@ -1,7 +1,7 @@
 //! Scenes: many objects, each a bank placed in space, sounded by timed impacts and contacts and
 //! heard from one listener's place (seed 001 sections 4-5, seed 003, seed 004).
 //!
-//! A scene file ([`format`]) names the objects, the events and the listener; the rigid bodies'
+//! A scene file ([`format`], read and checked by [`validate`]) names the objects, the events and the listener; the rigid bodies'
 //! impacts ([`physics`], by rapier3d) and hail or rain from emitters are events too. Each
 //! object plays its bank through an engine of its own (two when it is both struck and scraped:
 //! the exciter is an engine's); the listener ([`listener`]) hears it through
@@ -43,7 +43,8 @@ use format::{SceneError, SceneEvent, SceneFile, SceneObject};
 use listener::{air_absorption_db_per_m, place};
 use object::SoundingObject;
 
-pub use format::{parse_scene_str, scene_schema_json, SCENE_FORMAT, SCENE_VERSION};
+pub use format::{scene_schema_json, SCENE_FORMAT, SCENE_VERSION};
+pub use validate::parse_scene_str;
 
 /// Key every object's notes are played on: with key tracking off, any key plays the bank as
 /// authored.

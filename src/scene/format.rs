@@ -368,44 +368,6 @@ impl fmt::Display for SceneError {
 
 impl std::error::Error for SceneError {}
 
-/// Parses a scene from JSON text and checks it ([`validate`](super::validate::validate));
-/// `origin` names the text in messages.
-pub fn parse_scene_str(text: &str, origin: &str) -> Result<SceneFile, SceneError> {
-    let fail = |path: String, message: String| SceneError {
-        origin: origin.to_string(),
-        problems: vec![Problem { path, message }],
-    };
-    // The format first: a bank or another file given as a scene says so, not "unknown field".
-    let value: serde_json::Value =
-        serde_json::from_str(text).map_err(|e| fail(String::new(), e.to_string()))?;
-    match value.get("format") {
-        Some(serde_json::Value::String(f)) if f == SCENE_FORMAT => {}
-        Some(found) => {
-            return Err(fail(
-                "format".into(),
-                format!("expected \"{SCENE_FORMAT}\", found {found}"),
-            ))
-        }
-        None => {
-            return Err(fail(
-                String::new(),
-                format!("no \"format\": \"{SCENE_FORMAT}\""),
-            ))
-        }
-    }
-    let scene: SceneFile =
-        serde_json::from_str(text).map_err(|e| fail(String::new(), e.to_string()))?;
-    let problems = super::validate::validate(&scene);
-    if problems.is_empty() {
-        Ok(scene)
-    } else {
-        Err(SceneError {
-            origin: origin.to_string(),
-            problems,
-        })
-    }
-}
-
 /// The JSON Schema of [`SceneFile`], pretty-printed, with a final newline.
 pub fn scene_schema_json() -> String {
     let schema = schemars::schema_for!(SceneFile);

@@ -1,5 +1,6 @@
-//! The checks of a scene that its types do not make: the version, the limits, names that must
-//! be unique or must exist, and values in range, each problem with its JSON path.
+//! Reading a scene from text and the checks its types do not make: the version, the limits,
+//! names that must be unique or must exist, and values in range, each problem with its JSON
+//! path.
 
 use std::collections::{HashMap, HashSet};
 
@@ -8,6 +9,44 @@ use crate::bank::validate::Problem;
 
 /// Most problems reported at once.
 const MAX_PROBLEMS: usize = 20;
+
+/// Parses a scene from JSON text and checks it ([`validate`]); `origin` names the text in
+/// messages.
+pub fn parse_scene_str(text: &str, origin: &str) -> Result<SceneFile, SceneError> {
+    let fail = |path: String, message: String| SceneError {
+        origin: origin.to_string(),
+        problems: vec![Problem { path, message }],
+    };
+    // The format first: a bank or another file given as a scene says so, not "unknown field".
+    let value: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| fail(String::new(), e.to_string()))?;
+    match value.get("format") {
+        Some(serde_json::Value::String(f)) if f == SCENE_FORMAT => {}
+        Some(found) => {
+            return Err(fail(
+                "format".into(),
+                format!("expected \"{SCENE_FORMAT}\", found {found}"),
+            ))
+        }
+        None => {
+            return Err(fail(
+                String::new(),
+                format!("no \"format\": \"{SCENE_FORMAT}\""),
+            ))
+        }
+    }
+    let scene: SceneFile =
+        serde_json::from_str(text).map_err(|e| fail(String::new(), e.to_string()))?;
+    let problems = validate(&scene);
+    if problems.is_empty() {
+        Ok(scene)
+    } else {
+        Err(SceneError {
+            origin: origin.to_string(),
+            problems,
+        })
+    }
+}
 
 /// Every problem of `scene` that its types do not rule out, at most [`MAX_PROBLEMS`]: the
 /// version, the limits, names that must be unique or must exist, and the listener's place.
